@@ -1,0 +1,55 @@
+"""Timing and results files shared by the benchmark scripts.
+
+Every script times skmotion and its peers in the same run, reports ratios, and
+writes a CSV and a Markdown table to ``benchmarks/results/`` (git-ignored).
+"""
+
+import csv
+import platform
+import statistics
+import sys
+import time
+from pathlib import Path
+
+# Run from a checkout without installing: the repository root goes on the path.
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+RESULTS = Path(__file__).resolve().parent / "results"
+SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+
+
+def time_call(func, *, repeats=5, warmup=1):
+    """Median and spread of wall-clock seconds of ``func()`` over ``repeats`` runs."""
+    for _ in range(warmup):
+        func()
+    times = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        func()
+        times.append(time.perf_counter() - start)
+    return statistics.median(times), (statistics.stdev(times) if repeats > 1 else 0.0)
+
+
+def write_results(name, rows, *, notes=""):
+    """Write ``rows`` (a list of dicts) as ``results/<name>.csv`` and ``.md``; print the table."""
+    RESULTS.mkdir(exist_ok=True)
+    columns = list(rows[0].keys())
+    with open(RESULTS / f"{name}.csv", "w", newline="") as fh:
+        writer = csv.DictWriter(fh, fieldnames=columns)
+        writer.writeheader()
+        writer.writerows(rows)
+    lines = [f"# {name}", "", f"machine: {platform.platform()}, Python {platform.python_version()}", ""]
+    if notes:
+        lines += [notes, ""]
+    lines += ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]
+    lines += ["| " + " | ".join(_fmt(r[c]) for c in columns) + " |" for r in rows]
+    text = "\n".join(lines) + "\n"
+    (RESULTS / f"{name}.md").write_text(text)
+    print(text)
+    return text
+
+
+def _fmt(value):
+    if isinstance(value, float):
+        return f"{value:.4g}"
+    return str(value)

@@ -1,0 +1,156 @@
+"""Base mixins for estimators whose samples are motion clips."""
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+from sklearn import get_config
+from sklearn.base import TransformerMixin
+
+from skmotion.utils._clips import to_container
+
+__all__ = ["ClipEstimatorMixin", "ClipFeatureMixin", "ClipTransformerMixin", "MotionTags"]
+
+OUTPUT_KINDS = frozenset({"clips", "table", "labels", "scores"})
+
+
+@dataclass(frozen=True)
+class MotionTags:
+    """skmotion-specific facts about an estimator, beside sklearn's tags.
+
+    Parameters
+    ----------
+    variable_length : bool, default=True
+        Clips of one collection may have different numbers of frames.
+    output_kind : {"clips", "table", "labels", "scores"}, default="labels"
+        What ``transform``/``predict`` returns: clips (clip-to-clip transformer),
+        a table ``(n_clips, n_features)``, one label per clip, or scores.
+    requires_skeleton : bool, default=False
+        Whether the estimator needs a ``Skeleton`` to interpret its input.
+    min_frames : int, default=1
+        The fewest frames per clip the estimator accepts with default parameters.
+    """
+
+    variable_length: bool = True
+    output_kind: str = "labels"
+    requires_skeleton: bool = False
+    min_frames: int = 1
+
+    def __post_init__(self):
+        if self.output_kind not in OUTPUT_KINDS:
+            raise ValueError(
+                f"output_kind must be one of {sorted(OUTPUT_KINDS)}, got {self.output_kind!r}."
+            )
+
+
+class ClipEstimatorMixin:
+    """Mixin for estimators whose ``X`` is a collection of clips.
+
+    Sets sklearn's input tags (no 2-D tables, 3-D arrays accepted) and exposes
+    :class:`MotionTags` through ``__skmotion_tags__``. Put it first in the bases,
+    before sklearn's mixins and ``BaseEstimator``.
+    """
+
+    _motion_tags = MotionTags()
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.input_tags.two_d_array = False
+        tags.input_tags.three_d_array = True
+        return tags
+
+    def __skmotion_tags__(self):
+        """Return the estimator's :class:`MotionTags`."""
+        return self._motion_tags
+
+
+_OUTPUT_OPTIONS = frozenset({"default", "pandas"})
+
+
+def _check_output_option(transform):
+    if transform not in _OUTPUT_OPTIONS:
+        raise ValueError(
+            f"set_output(transform={transform!r}) is not supported; skmotion "
+            f"transformers support {sorted(_OUTPUT_OPTIONS)}."
+        )
+
+
+class _OutputConfigMixin(TransformerMixin):
+    """``set_output`` for clip transformers, without sklearn's automatic wrapping.
+
+    sklearn's wrapper would index a pandas result by the input's rows, which are
+    frames for a DataFrame collection; skmotion builds its containers itself.
+    """
+
+    def __init_subclass__(cls, **kwargs):
+        kwargs["auto_wrap_output_keys"] = None
+        super().__init_subclass__(**kwargs)
+
+    def set_output(self, *, transform=None):
+        """Choose the output container of ``transform`` and ``fit_transform``.
+
+        Parameters
+        ----------
+        transform : {"default", "pandas"}, default=None
+            ``"pandas"`` returns DataFrames; ``"default"`` the estimator's usual
+            output; ``None`` leaves the configuration unchanged.
+
+        Returns
+        -------
+        self : estimator instance
+            The estimator.
+        """
+        if transform is None:
+            return self
+        _check_output_option(transform)
+        self._sklearn_output_config = {"transform": transform}
+        return self
+
+    def _output_config(self):
+        config = getattr(self, "_sklearn_output_config", {}).get(
+            "transform", get_config()["transform_output"]
+        )
+        _check_output_option(config)
+        return config
+
+
+class ClipTransformerMixin(ClipEstimatorMixin, _OutputConfigMixin):
+    """Mixin for clip-to-clip transformers.
+
+    ``transform`` returns the container kind it was given (list, tuple, 3-D array
+    or DataFrame); after ``set_output(transform="pandas")`` it always returns a
+    ``(clip, frame)`` DataFrame.
+    """
+
+    _motion_tags = MotionTags(output_kind="clips")
+
+    def _wrap_clips(self, clips_out, clips_in, columns=None):
+        """Return ``clips_out`` in the kind of ``clips_in`` (a ``Clips``)."""
+        if columns is None and hasattr(self, "get_feature_names_out"):
+            columns = self.get_feature_names_out()
+        target = "pandas" if self._output_config() == "pandas" else clips_in.container
+        if target == "pandas" and clips_in.container.kind == "dataframe":
+            target = clips_in.container
+        return to_container(clips_out, target, columns=columns)
+
+
+class ClipFeatureMixin(ClipEstimatorMixin, _OutputConfigMixin):
+    """Mixin for clip-to-vector transformers: one row of features per clip.
+
+    ``transform`` returns an array ``(n_clips, n_features)``; after
+    ``set_output(transform="pandas")`` a DataFrame whose index holds the clip
+    labels of a DataFrame input (else ``0..n_clips-1``) and whose columns are
+    ``get_feature_names_out()``.
+    """
+
+    _motion_tags = MotionTags(output_kind="table")
+
+    def _wrap_table(self, table, clips_in):
+        """Return ``table`` as an array or, when configured, a DataFrame."""
+        if self._output_config() != "pandas":
+            return table
+        labels = clips_in.container.clip_labels
+        index = labels if labels is not None else pd.RangeIndex(len(table))
+        if clips_in.container.index_names:
+            index = pd.Index(np.asarray(index, dtype=object), name=clips_in.container.index_names[0])
+        return pd.DataFrame(table, index=index, columns=self.get_feature_names_out())

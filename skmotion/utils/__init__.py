@@ -1,0 +1,21 @@
+"""Utilities: the clip validator, container conversion, frame stacking, parallelism."""
+
+from skmotion.utils._clips import (
+    Clips,
+    Container,
+    check_clips,
+    split_frames,
+    stack_clips,
+    to_container,
+)
+from skmotion.utils._parallel import parallel_map
+
+__all__ = [
+    "Clips",
+    "Container",
+    "check_clips",
+    "parallel_map",
+    "split_frames",
+    "stack_clips",
+    "to_container",
+]
