@@ -1,6 +1,8 @@
-"""Datasets: the built-in synthetic motions and humanoid skeleton."""
+"""Datasets: the built-in synthetic motions and humanoid skeleton; loaders of real data."""
 
+from skmotion.datasets._home import get_data_home
 from skmotion.datasets._humanoid import humanoid_skeleton
 from skmotion.datasets._synthetic import MOTION_CLASSES, make_motions
+from skmotion.datasets._uea import load_uea
 
-__all__ = ["MOTION_CLASSES", "humanoid_skeleton", "make_motions"]
+__all__ = ["MOTION_CLASSES", "get_data_home", "humanoid_skeleton", "load_uea", "make_motions"]
