@@ -1,6 +1,29 @@
 """Preprocessing: clip-to-clip transformers and the steps that bridge to sklearn."""
 
+from skmotion.preprocessing._body_frame import body_frame_features, body_size
 from skmotion.preprocessing._flatten import FlattenClips
+from skmotion.preprocessing._marker_presets import (
+    MARKER_NAMES,
+    MARKER_PRESETS,
+    detect_marker_preset,
+    marker_preset,
+)
+from skmotion.preprocessing._marker_set import Marker, MarkerSet
 from skmotion.preprocessing._resample import ResampleClips, resample_clip
+from skmotion.preprocessing._virtual_markers import SIZE_CHAIN, VirtualMarkerTransform
 
-__all__ = ["FlattenClips", "ResampleClips", "resample_clip"]
+__all__ = [
+    "FlattenClips",
+    "MARKER_NAMES",
+    "MARKER_PRESETS",
+    "Marker",
+    "MarkerSet",
+    "ResampleClips",
+    "SIZE_CHAIN",
+    "VirtualMarkerTransform",
+    "body_frame_features",
+    "body_size",
+    "detect_marker_preset",
+    "marker_preset",
+    "resample_clip",
+]
