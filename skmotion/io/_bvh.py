@@ -137,8 +137,8 @@ def _frame_rate(path, line, text):
     rate = 1.0 / frame_time
     decimals = len(text.split(".")[1]) if "." in text and "e" not in text.lower() else 17
     whole = round(rate)
-    # 0.008333 is 120 Hz written to 6 decimals: keep 120 rather than 120.005.
-    if whole > 0 and abs(1.0 / whole - frame_time) <= 0.5 * 10.0**-decimals:
+    # 0.008333 is 120 Hz written to 6 decimals: keep 120 rather than 120.005 (but 0.03 s stays 33.3 Hz).
+    if whole > 0 and abs(1.0 / whole - frame_time) <= 0.5 * 10.0**-decimals and abs(rate - whole) < 1e-3 * whole:
         return float(whole)
     return rate
 
