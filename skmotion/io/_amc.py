@@ -39,6 +39,29 @@ def _joint_table(skeleton):
     return starts, counts, rotations
 
 
+def _joint_ids(tokens, which, skeleton):
+    """Skeleton joint index of each name token (-1 for unknown names).
+
+    The ~30 bone names repeat in every frame, so tokens are grouped by their
+    first 16 bytes and length with NumPy and only one token per group is
+    looked up; names longer than 16 bytes are looked up one by one.
+    """
+    index = {name.encode("latin-1"): j for j, name in enumerate(skeleton.joints)}
+    starts, ends = tokens.starts[which], tokens.ends[which]
+    lengths = ends - starts
+    buffer = np.frombuffer(tokens.data + bytes(16), dtype=np.uint8)
+    window = np.arange(16)
+    chars = np.where(window < lengths[:, None], buffer[starts[:, None] + window], 0).astype(np.uint8)
+    keys = np.ascontiguousarray(chars).view(np.uint64)
+    mixed = keys[:, 0] * np.uint64(0x9E3779B97F4A7C15) ^ keys[:, 1] ^ lengths.astype(np.uint64)
+    unique, first, inverse = np.unique(mixed, return_index=True, return_inverse=True)
+    exact = (keys == keys[first][inverse]).all(axis=1) & (lengths == lengths[first][inverse]) & (lengths <= 16)
+    ids = np.array([index.get(tokens.data[starts[k] : ends[k]], -1) for k in first], dtype=np.intp)[inverse]
+    for k in np.flatnonzero(~exact):
+        ids[k] = index.get(tokens.data[starts[k] : ends[k]], -1)
+    return ids
+
+
 def read_amc(path, skeleton, *, frame_rate=120.0):
     """Read an Acclaim motion (AMC) file for a skeleton from :func:`read_asf`.
 
@@ -119,12 +142,7 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
         k = misplaced[0]
         raise MotionFileError(path, int(tokens.lines[k]), f"non-numeric value {tokens.text(k)!r}")
     name_tokens = np.flatnonzero(named)
-    index = {name.encode("latin-1"): j for j, name in enumerate(skeleton.joints)}
-    raw = tokens.data
-    joints = np.array(
-        [index.get(raw[a:b], -1) for a, b in zip(tokens.starts[name_tokens].tolist(), tokens.ends[name_tokens].tolist())],
-        dtype=np.intp,
-    )
+    joints = _joint_ids(tokens, name_tokens, skeleton)
     if (joints < 0).any():
         k = name_tokens[np.flatnonzero(joints < 0)[0]]
         raise MotionFileError(path, int(tokens.lines[k]), f"unknown bone {tokens.text(k)!r} (not in the skeleton)")
@@ -167,8 +185,8 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     bone_frames = frame_of_line[~is_frame]
     bone_joints = line_joint[~is_frame]
     animated = np.flatnonzero(counts > 0)
-    seen = np.zeros((n_frames, skeleton.n_joints), dtype=np.intp)
-    np.add.at(seen, (bone_frames, bone_joints), 1)
+    seen = np.bincount(bone_frames * skeleton.n_joints + bone_joints, minlength=n_frames * skeleton.n_joints)
+    seen = seen.reshape(n_frames, skeleton.n_joints)
     wrong = seen[:, animated] != 1
     if wrong.any():
         f, a = np.argwhere(wrong)[0]
