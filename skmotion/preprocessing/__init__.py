@@ -10,7 +10,7 @@ from skmotion.preprocessing._marker_presets import (
 )
 from skmotion.preprocessing._marker_set import Marker, MarkerSet
 from skmotion.preprocessing._resample import ResampleClips, resample_clip
-from skmotion.preprocessing._virtual_markers import SIZE_CHAIN, VirtualMarkerTransform
+from skmotion.preprocessing._virtual_markers import SIZE_CHAIN, VirtualMarkerTransform, to_markers
 
 __all__ = [
     "FlattenClips",
@@ -26,4 +26,5 @@ __all__ = [
     "detect_marker_preset",
     "marker_preset",
     "resample_clip",
+    "to_markers",
 ]
