@@ -143,7 +143,7 @@ def _frame_rate(path, line, text):
     return rate
 
 
-def detect_up_axis(skeleton, channels, *, max_frames=100):
+def detect_up_axis(skeleton, channels, *, max_frames=25):
     """The vertical axis of a figure: the axis of its largest extent over the clip.
 
     A standing, walking or running figure is taller than it is wide or deep
@@ -155,7 +155,7 @@ def detect_up_axis(skeleton, channels, *, max_frames=100):
     ----------
     skeleton : Skeleton
     channels : ndarray of shape (n_frames, n_channels)
-    max_frames : int, default=100
+    max_frames : int, default=25
         How many frames to look at.
 
     Returns
@@ -195,6 +195,17 @@ def _motion_block(path, data, start, n_channels):
     n_frames = int(frames_text)
     frame_rate = _frame_rate(path, line_of(header.start(2)), header.group(2).decode("latin-1"))
     body = data[start + header.end() :]
+    if n_channels == 0:
+        raise MotionFileError(path, first_line, "the hierarchy has no channels")
+    if n_frames == 0:
+        raise MotionFileError(path, line_of(header.start(1)), "the file holds no frames")
+    try:
+        values = np.loadtxt(io.BytesIO(body), dtype=float, ndmin=2, comments=None)
+    except ValueError:
+        values = None
+    if values is not None and values.shape == (n_frames, n_channels) and np.isfinite(values).all():
+        return values, frame_rate
+    # Something is wrong: locate it exactly, token by token.
     tokens = Tokens(body, first_line=line_of(header.end()))
     per_line = tokens.per_line()
     filled = np.flatnonzero(per_line)
@@ -215,16 +226,7 @@ def _motion_block(path, data, start, n_channels):
             path, int(filled[n_frames]) + tokens.first_line,
             f"more frame lines than the {n_frames} declared by 'Frames:'",
         )
-    if n_frames == 0:
-        raise MotionFileError(path, line_of(header.start(1)), "the file holds no frames")
-    if n_channels == 0:
-        raise MotionFileError(path, first_line, "the hierarchy has no channels")
-    try:
-        values = np.loadtxt(io.BytesIO(body), dtype=float, ndmin=2, comments=None)
-    except ValueError:
-        values = None
-    if values is None or not np.isfinite(values).all():
-        values = parse_floats(tokens, path)  # names the offending line
+    values = parse_floats(tokens, path)  # names the offending line
     return values.reshape(n_frames, n_channels), frame_rate
 
 
