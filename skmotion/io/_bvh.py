@@ -15,6 +15,7 @@ __all__ = ["detect_up_axis", "read_bvh"]
 
 _CHANNELS = {c.lower(): c for c in CHANNEL_KINDS}
 _UP_AXES = ("x", "y", "z", None)
+_WORD = re.compile(r"[{}]|[^\s{}]+")
 
 
 class _HeaderParser:
@@ -22,10 +23,13 @@ class _HeaderParser:
 
     def __init__(self, path, text):
         self.path = path
-        self.tokens = []
-        for number, line in enumerate(text.split("\n"), start=1):
-            for word in line.replace("{", " { ").replace("}", " } ").split():
-                self.tokens.append((word, number))
+        words, starts = [], []
+        for match in _WORD.finditer(text):
+            words.append(match.group())
+            starts.append(match.start())
+        newlines = np.flatnonzero(np.frombuffer(text.encode("latin-1"), dtype=np.uint8) == 10)
+        lines = (np.searchsorted(newlines, starts) + 1).tolist()
+        self.tokens = list(zip(words, lines))
         self.pos = 0
         self.joints, self.parents, self.offsets, self.channels = [], [], [], []
 
@@ -57,6 +61,18 @@ class _HeaderParser:
             raise self.error(f"non-finite value {word!r} in {context}", line)
         return value
 
+    def offset(self, context):
+        """Three numbers; the fast path converts them at once."""
+        chunk = self.tokens[self.pos : self.pos + 3]
+        try:
+            values = [float(word) for word, _ in chunk]
+        except ValueError:
+            values = []
+        if len(values) == 3 and np.isfinite(values).all():
+            self.pos += 3
+            return values
+        return [self.number(context) for _ in range(3)]  # names the offending token
+
     def parse(self):
         self.expect("HIERARCHY", "at the start of a BVH file")
         self.expect("ROOT", "after HIERARCHY")
@@ -78,7 +94,7 @@ class _HeaderParser:
         self.parents.append(parent)
         opened = self.expect("{", f"after joint {name!r}")
         self.expect("OFFSET", f"in joint {name!r}")
-        self.offsets.append([self.number(f"OFFSET of {name!r}") for _ in range(3)])
+        self.offsets.append(self.offset(f"OFFSET of {name!r}"))
         self.channels.append(self.channel_list(name))
         while True:
             word, line = self.next(f"'}}' closing joint {name!r} (opened at line {opened})")
@@ -118,7 +134,7 @@ class _HeaderParser:
             name, suffix = f"{self.joints[parent]}_end{suffix}", suffix + 1
         opened = self.expect("{", "after End Site")
         self.expect("OFFSET", "in End Site")
-        offset = [self.number(f"OFFSET of the End Site of {self.joints[parent]!r}") for _ in range(3)]
+        offset = self.offset(f"OFFSET of the End Site of {self.joints[parent]!r}")
         self.expect("}", f"closing the End Site opened at line {opened}")
         self.joints.append(name)
         self.parents.append(parent)
