@@ -368,17 +368,26 @@ def to_markers(motions, transformer=None):
 
     Examples
     --------
-    >>> import numpy as np
     >>> from skmotion.datasets import make_motions
     >>> from skmotion.io import Motion, as_motions
-    >>> from skmotion.preprocessing import to_markers
+    >>> from skmotion.kinematics import Skeleton
+    >>> from skmotion.preprocessing import VirtualMarkerTransform, to_markers
     >>> data = make_motions(n_clips_per_class=1, classes=["walk", "wave"], random_state=0)
     >>> motions = as_motions(data.clips, data.skeletons, data.frame_rate)
-    >>> # The same wave on a skeleton without the hand's end site: fewer joints, same channels here,
-    >>> # but clips of any channel layout may be mixed.
-    >>> clips, names = to_markers(motions)
+    >>> # A second skeleton family: the humanoid without toes has 6 channels fewer.
+    >>> sk = motions[1].skeleton
+    >>> keep = [j for j, name in enumerate(sk.joints) if "Toe" not in name]
+    >>> bare = Skeleton([sk.joints[j] for j in keep], [keep.index(sk.parents[j]) if j else -1 for j in keep],
+    ...                 sk.offsets[keep], [sk.channels[j] for j in keep], up_axis="y")
+    >>> columns = [c for c, name in enumerate(sk.channel_names) if "Toe" not in name]
+    >>> motions[1] = Motion(bare, motions[1].channels[:, columns], frame_rate=30.0)
+    >>> motions[0].n_channels, motions[1].n_channels
+    (66, 60)
+    >>> clips, names = to_markers(motions, VirtualMarkerTransform(markers=[
+    ...     ("pelvis", "Hips", (0, 0, 0)), ("left_hip", "LeftUpLeg", (0, 0, 0)),
+    ...     ("right_hip", "RightUpLeg", (0, 0, 0)), ("head", "Head", (0, 0, 0))], size_markers=None))
     >>> [c.shape[1] for c in clips], names[0]
-    ([192, 192], 'head_top_px')
+    ([24, 24], 'pelvis_px')
     """
     transformer = VirtualMarkerTransform() if transformer is None else transformer
     motions = list(motions)

@@ -9,7 +9,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
-from skmotion.datasets import humanoid_skeleton, make_motions
+from skmotion.datasets import make_motions
 from skmotion.io import Motion, MotionFileError, read_bvh, write_bvh
 from skmotion.kinematics import Skeleton
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from sklearn.base import clone
 from sklearn.linear_model import RidgeClassifier
 from sklearn.model_selection import GridSearchCV, GroupKFold, cross_val_score
 from sklearn.pipeline import make_pipeline
@@ -22,6 +23,7 @@ from skmotion.preprocessing import (
     body_size,
     detect_marker_preset,
     marker_preset,
+    to_markers,
 )
 from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 
@@ -228,3 +230,25 @@ def test_errors_name_what_and_where():
     with pytest.raises(ValueError, match="size marker 'left_ankle'"):
         VirtualMarkerTransform(SK, markers=custom, root_marker="base", facing_markers=("l", "r"),
                                frame_rate=30.0).fit(data.clips)
+
+
+def test_to_markers_mixes_channel_layouts_in_input_order():
+    data = small_data(7)
+    motions = as_motions(data.clips[:4], data.skeletons[:4], data.frame_rate)
+    sk = motions[1].skeleton
+    keep = [j for j, name in enumerate(sk.joints) if "Toe" not in name]
+    bare = Skeleton([sk.joints[j] for j in keep], [keep.index(sk.parents[j]) if j else -1 for j in keep],
+                    sk.offsets[keep], [sk.channels[j] for j in keep], up_axis="y")
+    columns = [c for c, name in enumerate(sk.channel_names) if "Toe" not in name]
+    motions[1] = Motion(bare, motions[1].channels[:, columns], frame_rate=30.0)
+    custom = VirtualMarkerTransform(markers=[("pelvis", "Hips", (0, 0, 0)), ("left_hip", "LeftUpLeg", (0, 0, 0)),
+                                             ("right_hip", "RightUpLeg", (0, 0, 0)), ("top", "Head_end", (0, 0, 0))],
+                                    size_markers=["pelvis", "top"])
+    clips, names = to_markers(motions, custom)
+    assert names.tolist()[:2] == ["pelvis_px", "pelvis_py"] and len(clips) == 4
+    for i in (0, 1, 3):
+        np.testing.assert_array_equal(clips[i], clone(custom).fit_transform([motions[i]])[0])
+    with pytest.raises(ValueError, match="No marker preset fits|needs joints"):
+        to_markers(motions)  # the standard preset needs the toes
+    with pytest.raises(TypeError, match="item 0 is a ndarray, not a Motion"):
+        to_markers([data.clips[0]])
