@@ -146,7 +146,6 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     if (joints < 0).any():
         k = name_tokens[np.flatnonzero(joints < 0)[0]]
         raise MotionFileError(path, int(tokens.lines[k]), f"unknown bone {tokens.text(k)!r} (not in the skeleton)")
-    values = parse_floats(tokens, path, which=~named)
 
     # Line structure: frame lines hold a lone number; bone lines a name and its values.
     lead_tokens = np.flatnonzero(lead)
@@ -170,6 +169,7 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
         )
 
     # Frame numbers, and which frame each bone line belongs to.
+    values = parse_floats(tokens, path, which=~named, rows=lead_tokens[is_frame])
     value_index = np.cumsum(~named) - 1  # position of each numeric token in ``values``
     frame_numbers = values[value_index[lead_tokens[is_frame]]]
     frame_lines = tokens.lines[lead_tokens[is_frame]]

@@ -5,6 +5,8 @@ raw bytes, so checking the layout (values per line, which line a token is on)
 costs a few array operations rather than a Python loop over lines.
 """
 
+import io
+
 import numpy as np
 
 from skmotion.io._errors import MotionFileError
@@ -64,8 +66,28 @@ class Tokens:
         return np.bincount(self.lines - self.first_line, minlength=self.n_lines)
 
 
-def parse_floats(tokens, path, which=None):
-    """The tokens (all, or those selected by ``which``) as floats.
+def _blanked(tokens, drop):
+    """The text with the tokens selected by ``drop`` overwritten by spaces."""
+    buffer = np.frombuffer(tokens.data, dtype=np.uint8).copy()
+    starts, ends = tokens.starts[drop], tokens.ends[drop]
+    lengths = ends - starts
+    offsets = np.arange(lengths.sum()) - np.repeat(np.cumsum(lengths) - lengths, lengths)
+    buffer[np.repeat(starts, lengths) + offsets] = 32
+    return buffer
+
+
+def _as_table(buffer, tokens, rows):
+    """Values via ``numpy.loadtxt``, one text line per row; None when rows differ in length."""
+    buffer[(buffer == 10) | (buffer == 13)] = 32
+    buffer[tokens.starts[rows[1:]] - 1] = 10  # a token start always follows a separator
+    try:
+        return np.loadtxt(io.BytesIO(buffer.tobytes()), dtype=float, ndmin=2, comments=None).ravel()
+    except ValueError:
+        return None
+
+
+def parse_floats(tokens, path, which=None, rows=None):
+    """The tokens (all, or those selected by ``which``) as floats, in file order.
 
     Non-numeric and non-finite values raise a MotionFileError naming the line.
 
@@ -76,23 +98,31 @@ def parse_floats(tokens, path, which=None):
         For error messages.
     which : ndarray of bool, default=None
         Tokens to parse; the others are blanked out first.
+    rows : ndarray of int, default=None
+        Indices of the tokens that start a record (an AMC frame number). When
+        every record holds the same number of values the text is reshaped to
+        one line per record and parsed by ``numpy.loadtxt``, which is faster.
 
     Returns
     -------
     values : ndarray of float
     """
-    data = tokens.data
-    if which is not None and not which.all():
-        buffer = np.frombuffer(data, dtype=np.uint8).copy()
-        starts, ends = tokens.starts[~which], tokens.ends[~which]
-        lengths = ends - starts
-        offsets = np.arange(lengths.sum()) - np.repeat(np.cumsum(lengths) - lengths, lengths)
-        buffer[np.repeat(starts, lengths) + offsets] = 32
-        data = buffer.tobytes()
-    try:
-        values = np.array(data.split(), dtype=float)
-    except ValueError:
-        values = None
+    drop = None if which is None else ~which
+    buffer = _blanked(tokens, drop) if drop is not None and drop.any() else None
+    values = None
+    if rows is not None and len(rows):
+        per_row = np.diff(np.r_[rows, len(tokens)]) - (
+            np.add.reduceat(drop.astype(np.intp), rows) if drop is not None else 0
+        )
+        if (per_row == per_row[0]).all():
+            base = buffer if buffer is not None else np.frombuffer(tokens.data, dtype=np.uint8).copy()
+            values = _as_table(base, tokens, rows)
+    if values is None:
+        data = tokens.data if buffer is None else buffer.tobytes()
+        try:
+            values = np.array(data.split(), dtype=float)
+        except ValueError:
+            values = None
     if values is not None and np.isfinite(values).all():
         return values
     index = np.flatnonzero(which) if which is not None else np.arange(len(tokens))
