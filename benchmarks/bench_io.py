@@ -8,13 +8,15 @@ line-by-line parser (a dict of bone values per frame, as the common Python AMC
 readers do). Run: ``python benchmarks/bench_io.py`` (needs ``pip install -e ".[bench]"``).
 """
 
+import statistics
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA, time_call, write_results  # noqa: E402
+from _common import SHARED_DATA, write_results  # noqa: E402
 
 from skmotion.io import read_amc, read_asf, read_bvh  # noqa: E402
 
@@ -48,6 +50,19 @@ def line_by_line_amc(path):
     return frames
 
 
+def interleaved(funcs, rounds):
+    """Median seconds of each function, timed in alternation so that they share the machine's load."""
+    for func in funcs:
+        func()  # warm-up
+    times = [[] for _ in funcs]
+    for _ in range(rounds):
+        for func, bucket in zip(funcs, times):
+            start = time.perf_counter()
+            func()
+            bucket.append(time.perf_counter() - start)
+    return [statistics.median(bucket) for bucket in times]
+
+
 def bench_bvh(files, repeats):
     rows = []
     for path in files:
@@ -55,9 +70,9 @@ def bench_bvh(files, repeats):
         ours = read_bvh(path)
         degrees = np.where([c.endswith("rotation") for c in ours.channel_names], np.rad2deg(ours.channels), ours.channels)
         np.testing.assert_allclose(degrees, peer_bvh(path), atol=1e-9)  # the same numbers
-        fast, _ = time_call(lambda: read_bvh(path), repeats=repeats)
-        bvh_time, _ = time_call(lambda: peer_bvh(path), repeats=max(1, repeats // 2))
-        bvhio_time, _ = time_call(lambda: peer_bvhio(path), repeats=max(1, repeats // 2))
+        fast, bvh_time, bvhio_time = interleaved(
+            [lambda: read_bvh(path), lambda: peer_bvh(path), lambda: peer_bvhio(path)], repeats
+        )
         rows.append(
             {
                 "file": f"{path.parent.name}/{path.name}",
@@ -80,8 +95,7 @@ def bench_amc(files, repeats):
         skeleton = read_asf(path.with_name(f"{path.stem.split('_')[0]}.asf"))
         motion = read_amc(path, skeleton)
         assert len(line_by_line_amc(path)) == motion.n_frames
-        fast, _ = time_call(lambda: read_amc(path, skeleton), repeats=repeats)
-        slow, _ = time_call(lambda: line_by_line_amc(path), repeats=max(1, repeats // 2))
+        fast, slow = interleaved([lambda: read_amc(path, skeleton), lambda: line_by_line_amc(path)], repeats)
         rows.append(
             {
                 "file": f"{path.parent.name}/{path.name}",
@@ -103,7 +117,7 @@ def main(n_files=4, repeats=5):
     write_results(
         "io_bvh",
         bvh_rows,
-        notes="MB/s of reading a BVH file to channel values in memory (median of repeats); speedup = "
+        notes="MB/s of reading a BVH file to channel values in memory (median of 5 interleaved rounds); speedup = "
         "time of the fastest of bvh and bvhio / time of skmotion.read_bvh (target >= 5).",
     )
     amc_rows = bench_amc(by_size(SHARED_DATA.glob("cmu-asfamc/*/*.amc")), repeats)
