@@ -9,7 +9,7 @@ from skmotion.utils._clips import check_clips
 from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, validate_params
 
-__all__ = ["pairwise_psi", "psi", "psi_signatures", "psi_from_signatures"]
+__all__ = ["pairwise_psi", "psi", "psi_from_signatures", "psi_signatures", "signatures_from_spectra"]
 
 # Rows of the similarity matrix per task: bounds memory, independent of n_jobs.
 _ROWS = 1024
@@ -36,13 +36,21 @@ def psi_signatures(clips, k, *, n_jobs=None):
         The matching unit eigenvectors (zeros beyond a clip's rank).
     """
     k = min(int(k), clips[0].shape[1])
-    eigenvalues, vectors = clip_spectra(clips, k, n_jobs=n_jobs)
+    return signatures_from_spectra(*clip_spectra(clips, k, n_jobs=n_jobs), k)
+
+
+def signatures_from_spectra(eigenvalues, vectors, k):
+    """:func:`psi_signatures` from spectra already computed by ``clip_spectra``.
+
+    ``vectors`` must hold at least ``min(k, n_channels)`` vectors per clip.
+    """
+    k = min(int(k), eigenvalues.shape[1])
     top = eigenvalues[:, :k]
     total = top.sum(axis=1, keepdims=True)
     empty = np.flatnonzero(total[:, 0] == 0)
     if empty.size:
         raise ValueError(f"clip {empty[0]} is all zeros; psi is not defined for it.")
-    return top / total, np.ascontiguousarray(vectors.transpose(0, 2, 1))
+    return top / total, np.ascontiguousarray(vectors[:, :, :k].transpose(0, 2, 1))
 
 
 def psi_from_signatures(weights_a, vectors_a, weights_b, vectors_b):
