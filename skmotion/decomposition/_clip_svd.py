@@ -10,9 +10,22 @@ which is cheaper there. Nothing loops over frames.
 
 import numpy as np
 
+# threadpoolctl comes with scikit-learn (one of its own dependencies).
+from threadpoolctl import threadpool_limits
+
 from skmotion.utils._parallel import parallel_map
 
-__all__ = ["clip_spectra"]
+__all__ = ["clip_spectra", "small_blas"]
+
+
+def small_blas():
+    """Context in which BLAS/LAPACK run on one thread.
+
+    Per-clip problems are small (tens of channels): a multithreaded BLAS spends
+    far longer synchronising its threads than computing, and on a busy machine
+    it slows them a hundredfold. Parallelism comes from ``n_jobs`` instead.
+    """
+    return threadpool_limits(limits=1, user_api="blas")
 
 # Clips per task: fixed, so the tasks (and so the results) do not depend on n_jobs.
 _CHUNK = 512
@@ -83,5 +96,6 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     """
     n_vectors = min(int(n_vectors), clips[0].shape[1])
     chunks = [clips[i : i + _CHUNK] for i in range(0, len(clips), _CHUNK)]
-    parts = parallel_map(lambda chunk: _spectra_of_chunk(chunk, n_vectors), chunks, n_jobs=n_jobs)
+    with small_blas():
+        parts = parallel_map(lambda chunk: _spectra_of_chunk(chunk, n_vectors), chunks, n_jobs=n_jobs)
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])

@@ -4,7 +4,6 @@ from numbers import Integral, Real
 
 import numpy as np
 import pandas as pd
-import scipy.sparse as sp
 from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.metrics.pairwise import euclidean_distances
 from sklearn.utils.multiclass import check_classification_targets
@@ -12,7 +11,7 @@ from sklearn.utils.validation import check_is_fitted, column_or_1d, validate_dat
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.decomposition import SVDFeatureExtractor
-from skmotion.decomposition._clip_svd import clip_spectra
+from skmotion.decomposition._clip_svd import clip_spectra, small_blas
 from skmotion.decomposition._svd_features import _N_VECTORS
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
@@ -27,14 +26,19 @@ _LEAVES_PER_TASK = 32
 
 
 def _is_table(X):
-    """A 2-D table of feature vectors (not a clip collection)?"""
-    if sp.issparse(X):
-        return True
+    """A 2-D table of feature vectors rather than a clip collection?
+
+    Clips are a list or tuple of 2-D arrays, a 3-D array or a ``(clip, frame)``
+    DataFrame; anything else (a 2-D array, a list of 1-D rows, a plain DataFrame)
+    is a table.
+    """
+    if isinstance(X, (list, tuple)):
+        return len(X) > 0 and np.ndim(X[0]) == 1
     if isinstance(X, np.ndarray):
         return X.ndim != 3
     if isinstance(X, pd.DataFrame):
         return not isinstance(X.index, pd.MultiIndex)
-    return False
+    return True
 
 
 def learn_delta(features, labels, quantile):
@@ -248,6 +252,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self : IntervalIndexNeighbors
             The fitted index.
         """
+        return self._fit(X, y)
+
+    def _fit(self, X, y, classes=None):
         features, ranking = self._describe(X, reset=True)
         y = self._check_labels(y, len(features))
         if self.input_kind_ == "table" and features.shape[1] < self.n_levels:
@@ -255,7 +262,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
                 f"n_levels={self.n_levels} needs feature vectors with at least that many "
                 f"columns; X has {features.shape[1]} feature(s)."
             )
-        self.classes_, encoded = np.unique(y, return_inverse=True)
+        self.classes_ = np.unique(y if classes is None else classes)
+        self._check_known(y)
+        encoded = np.searchsorted(self.classes_, y)
         tree_features = features[:, : self.n_levels]
         self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
         radius = self.epsilon * self.delta_
@@ -291,12 +300,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         check_is_fitted(self)
         features, ranking = self._describe(X, reset=False)
         y = self._check_labels(y, len(features))
-        unseen = np.setdiff1d(y, self.classes_)
-        if unseen.size:
-            raise ValueError(
-                f"y: labels {unseen.tolist()} were not seen in fit; insert takes labels from "
-                f"classes_ ({self.classes_.tolist()}); refit to add classes."
-            )
+        self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
         tree_features = features[:, : self.n_levels]
         self.index_.insert(tree_features)
@@ -310,7 +314,16 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self.n_samples_fit_ += len(features)
         return self
 
-    def partial_fit(self, X, y):
+    def _check_known(self, y):
+        unseen = np.setdiff1d(y, self.classes_)
+        if unseen.size:
+            raise ValueError(
+                f"y: labels {unseen.tolist()} are not among the classes "
+                f"{self.classes_.tolist()}; refit (or pass classes to the first partial_fit) "
+                "to add classes."
+            )
+
+    def partial_fit(self, X, y, classes=None):
         """Fit on the first call, then :meth:`insert`.
 
         Parameters
@@ -319,6 +332,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             Clips to index.
         y : array-like of shape (n_clips,)
             Their labels.
+        classes : array-like of shape (n_classes,), default=None
+            All the labels later calls may bring; used on the first call only
+            (by default the labels of that call).
 
         Returns
         -------
@@ -326,8 +342,12 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             The index.
         """
         if not hasattr(self, "index_"):
-            return self.fit(X, y)
+            return self._fit_first(X, y, classes)
         return self.insert(X, y)
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def _fit_first(self, X, y, classes):
+        return self._fit(X, y, classes)
 
     # -- queries -------------------------------------------------------------------
 
@@ -422,7 +442,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
         distances = np.empty((len(features), n_neighbors))
         indices = np.empty((len(features), n_neighbors), dtype=np.intp)
-        for part in parallel_map(rank, tasks, n_jobs=self.n_jobs):
+        with small_blas():
+            ranked = parallel_map(rank, tasks, n_jobs=self.n_jobs)
+        for part in ranked:
             for rows, dist, ind in part:
                 distances[rows], indices[rows] = dist, ind
         return (distances, indices) if return_distance else indices
@@ -458,4 +480,5 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         labels : ndarray of shape (n_queries,)
             Ties go to the first class in ``classes_``.
         """
-        return self.classes_[self.predict_proba(X).argmax(axis=1)]
+        proba = self.predict_proba(X)
+        return self.classes_[proba.argmax(axis=1)]
