@@ -14,13 +14,14 @@ node is identified by the entries taken above it.
 
 Layout: per level, a dense table ``child[node, entry] -> node of the next level``
 (``int32``, grown by doubling), where node 0 is a dead end whose children are
-all 0 and node 1 is the root; the last level's table points at leaves, and
-``leaves[leaf]`` is the sorted ``int32`` array of item ids in that leaf. Queries
+all 0 and node 1 is the root; the last level's table points at leaves (leaf 0
+is empty). Leaf contents are kept as a few sorted blocks, each a CSR layout
+(leaf ids, offsets, item ids) built from one insertion; blocks of similar size
+are merged, so there are O(log n) of them and every step is vectorised. Queries
 are vectorised over a batch: one ``searchsorted`` and one fancy index per level.
 """
 
 import math
-import sys
 
 import numpy as np
 
@@ -112,7 +113,8 @@ class IntervalIndex:
         # Level 0 holds the dead node 0 and the root 1.
         self._tables = [np.zeros((2 if level == 0 else 1, n), dtype=np.int32) for level, n in enumerate(self.n_entries)]
         self._n_nodes = [2] + [1] * (self.n_levels - 1)
-        self._leaves = [_EMPTY]
+        self._n_leaves = 1
+        self._blocks = []  # (leaf ids, offsets, items), oldest (lowest item ids) first
         self.n_items = 0
 
     @property
@@ -122,7 +124,7 @@ class IntervalIndex:
     @property
     def n_nodes(self):
         """Number of nodes per level (without the dead node), then of leaves."""
-        return [n - 1 for n in self._n_nodes] + [len(self._leaves) - 1]
+        return [n - 1 for n in self._n_nodes] + [self._n_leaves - 1]
 
     # -- entries ---------------------------------------------------------------
 
@@ -178,11 +180,11 @@ class IntervalIndex:
             n = table.shape[1]
             keys, inverse = np.unique(node[missing] * n + entry[missing], return_inverse=True)
             last_level = level == self.n_levels - 1
-            start = len(self._leaves) if last_level else self._n_nodes[level + 1]
+            start = self._n_leaves if last_level else self._n_nodes[level + 1]
             new = np.arange(start, start + len(keys), dtype=np.int32)
             table[keys // n, keys % n] = new
             if last_level:
-                self._leaves.extend([_EMPTY] * len(keys))
+                self._n_leaves += len(keys)
             else:
                 self._n_nodes[level + 1] += len(keys)
                 self._grow(level + 1, self._n_nodes[level + 1])
@@ -198,12 +200,25 @@ class IntervalIndex:
             offset = np.arange(len(repeat)) - np.repeat(np.cumsum(span) - span, span)
             item, node = item[repeat], node[repeat]
             node = self._children(level, node, lo[repeat] + offset)
-        order = np.argsort(node, kind="stable")  # keeps ids increasing within a leaf
-        leaf, members = node[order], ids[item[order]]
-        bounds = np.flatnonzero(np.r_[True, leaf[1:] != leaf[:-1], True])
-        for start, stop in zip(bounds[:-1], bounds[1:]):
-            target = leaf[start]
-            self._leaves[target] = np.concatenate((self._leaves[target], members[start:stop]))
+        self._add_block(node, ids[item])
+
+    @staticmethod
+    def _block(leaf, items):
+        """CSR block from (leaf, item) pairs; a stable sort keeps items increasing per leaf."""
+        order = np.argsort(leaf, kind="stable")
+        leaf, items = leaf[order], items[order]
+        starts = np.flatnonzero(np.r_[True, leaf[1:] != leaf[:-1]])
+        return leaf[starts].astype(np.int32), np.r_[starts, len(leaf)].astype(np.int64), items.astype(np.int32)
+
+    def _add_block(self, leaf, items):
+        self._blocks.append(self._block(leaf, items))
+        # Merge while the newer block is at least half the older one: sizes then
+        # halve along the list, so there are O(log n) blocks and each pair is
+        # copied O(log n) times.
+        while len(self._blocks) > 1 and 2 * len(self._blocks[-1][2]) >= len(self._blocks[-2][2]):
+            newer, older = self._blocks.pop(), self._blocks.pop()
+            leaves = np.concatenate([np.repeat(b[0], np.diff(b[1])) for b in (older, newer)])
+            self._blocks.append(self._block(leaves, np.concatenate([older[2], newer[2]])))
 
     def insert(self, vectors):
         """Insert vectors; each goes into every leaf its covering intervals reach.
@@ -241,19 +256,25 @@ class IntervalIndex:
         return node
 
     def leaf_items(self, leaf):
-        """Sorted ids of the items in a leaf (an ``int32`` array; do not modify)."""
-        return self._leaves[leaf]
+        """Sorted ids of the items in a leaf, as an ``int32`` array."""
+        parts = []
+        for leaves, offsets, items in self._blocks:
+            at = np.searchsorted(leaves, leaf)
+            if at < len(leaves) and leaves[at] == leaf:
+                parts.append(items[offsets[at] : offsets[at + 1]])
+        if len(parts) == 1:
+            return parts[0]
+        return np.concatenate(parts) if parts else _EMPTY
 
     def candidates(self, vectors):
         """For each query, the sorted ids of the items in the leaf it reaches."""
-        return [self._leaves[leaf].astype(np.intp) for leaf in self.leaf_of(vectors)]
+        return [self.leaf_items(leaf).astype(np.intp) for leaf in self.leaf_of(vectors)]
 
     def nbytes(self):
-        """Memory held by the tree: node tables, leaf arrays and their overhead."""
+        """Memory held by the tree: node tables and leaf blocks."""
         tables = sum(t.nbytes for t in self._tables)
-        leaves = sum(a.nbytes for a in self._leaves) + sys.getsizeof(_EMPTY) * len(self._leaves)
-        return tables + leaves + sys.getsizeof(self._leaves)
+        return tables + sum(a.nbytes for block in self._blocks for a in block)
 
     def n_stored(self):
         """Number of (leaf, item) pairs, i.e. the total size of the leaves."""
-        return int(sum(len(a) for a in self._leaves))
+        return int(sum(len(block[2]) for block in self._blocks))
