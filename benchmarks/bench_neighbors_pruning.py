@@ -26,9 +26,9 @@ from skmotion.neighbors import IntervalIndexNeighbors  # noqa: E402
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges  # noqa: E402
 from skmotion.neighbors._interval_neighbors import learn_delta  # noqa: E402
 
-EPSILONS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2)
-LEVELS = (5, 6, 7, 8, 9, 10, 12)
-MAX_PAIRS = 40_000_000  # leaf entries; a larger tree is skipped (memory)
+EPSILONS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.0, 1.2)
+LEVELS = (5, 6, 7, 8, 10, 12)
+MAX_PAIRS = 10_000_000  # leaf entries; a larger tree is skipped (memory)
 
 
 def leaf_entries(features, labels, n_levels, epsilon, max_entries=64):

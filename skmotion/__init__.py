@@ -15,6 +15,7 @@ _SUBPACKAGES = (
     "preprocessing",
     "utils",
 )
+_SUBPACKAGES += ("decomposition", "metrics", "neighbors", "plotting")
 
 __all__ = ["__version__", *_SUBPACKAGES]
 

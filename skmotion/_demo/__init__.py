@@ -11,6 +11,7 @@ from types import SimpleNamespace
 __all__ = ["SECTIONS", "run_demo"]
 
 SECTIONS = ("skmotion._demo.data",)
+SECTIONS += ("skmotion._demo.index",)
 
 
 def run_demo(write, *, random_state=0, sections=SECTIONS):

@@ -11,7 +11,7 @@ which is cheaper there. Nothing loops over frames.
 import numpy as np
 
 # threadpoolctl comes with scikit-learn (one of its own dependencies).
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from skmotion.utils._parallel import parallel_map
 
@@ -25,7 +25,13 @@ def small_blas():
     far longer synchronising its threads than computing, and on a busy machine
     it slows them a hundredfold. Parallelism comes from ``n_jobs`` instead.
     """
-    return threadpool_limits(limits=1, user_api="blas")
+    global _CONTROLLER
+    if _CONTROLLER is None:  # finding the loaded BLAS libraries is slow: do it once
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER.limit(limits=1, user_api="blas")
+
+
+_CONTROLLER = None
 
 # Clips per task: fixed, so the tasks (and so the results) do not depend on n_jobs.
 _CHUNK = 512

@@ -58,6 +58,21 @@ def learn_delta(features, labels, quantile):
     return np.quantile(np.stack(spreads), quantile, axis=0)
 
 
+def _extend(buffer, n, new):
+    """Write ``new`` after the first ``n`` rows of ``buffer``, growing it by doubling.
+
+    Insertions then cost amortised O(new rows), not a copy of everything stored.
+    """
+    need = n + len(new)
+    if buffer is None or need > len(buffer):
+        grown = np.empty((max(need, 2 * (0 if buffer is None else len(buffer))),) + new.shape[1:], dtype=new.dtype)
+        if buffer is not None:
+            grown[:n] = buffer[:n]
+        buffer = grown
+    buffer[n:need] = new
+    return buffer
+
+
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     """Similarity search and k-NN classification of clips through an interval index.
 
@@ -273,12 +288,33 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self.index_ = IntervalIndex(edges, radius)
         self.index_.insert(tree_features)
         self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
-        self._tree_features = tree_features
-        self._ranking = ranking
-        self._encoded = encoded
-        self.labels_ = self.classes_[encoded]
-        self.n_samples_fit_ = len(features)
+        self.n_samples_fit_ = 0
+        self._buffers = None
+        self._store(tree_features, ranking, encoded)
         return self
+
+    def _store(self, tree_features, ranking, encoded):
+        """Append clips' tree features, ranking data and labels to the stored ones."""
+        new = (tree_features, encoded, *(ranking if isinstance(ranking, tuple) else (ranking,)))
+        old = self._buffers or (None,) * len(new)
+        n = self.n_samples_fit_
+        self._buffers = tuple(_extend(b, n, a) for b, a in zip(old, new))
+        self.n_samples_fit_ = n + len(tree_features)
+        self.labels_ = self.classes_[self._encoded]
+
+    @property
+    def _tree_features(self):
+        return self._buffers[0][: self.n_samples_fit_]
+
+    @property
+    def _encoded(self):
+        return self._buffers[1][: self.n_samples_fit_]
+
+    @property
+    def _ranking(self):
+        """Signatures (weights, vectors) for psi, or the feature vectors."""
+        parts = tuple(b[: self.n_samples_fit_] for b in self._buffers[2:])
+        return parts if self.effective_metric_ == "psi" else parts[0]
 
     def insert(self, X, y):
         """Add clips to the fitted index, without rebuilding it.
@@ -304,14 +340,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         encoded = np.searchsorted(self.classes_, y)
         tree_features = features[:, : self.n_levels]
         self.index_.insert(tree_features)
-        self._tree_features = np.concatenate([self._tree_features, tree_features])
-        if self.effective_metric_ == "psi":
-            self._ranking = tuple(np.concatenate([a, b]) for a, b in zip(self._ranking, ranking))
-        else:
-            self._ranking = np.concatenate([self._ranking, ranking])
-        self._encoded = np.concatenate([self._encoded, encoded])
-        self.labels_ = self.classes_[self._encoded]
-        self.n_samples_fit_ += len(features)
+        self._store(tree_features, ranking, encoded)
         return self
 
     def _check_known(self, y):
