@@ -10,8 +10,12 @@ __version__ = "0.1.0"
 _SUBPACKAGES = (
     "base",
     "datasets",
+    "decomposition",
     "io",
     "kinematics",
+    "metrics",
+    "neighbors",
+    "plotting",
     "preprocessing",
     "utils",
 )

@@ -10,7 +10,7 @@ from types import SimpleNamespace
 
 __all__ = ["SECTIONS", "run_demo"]
 
-SECTIONS = ("skmotion._demo.data", "skmotion._demo.markers")
+SECTIONS = ("skmotion._demo.data", "skmotion._demo.markers", "skmotion._demo.index")
 
 
 def run_demo(write, *, random_state=0, sections=SECTIONS, **options):

@@ -1,0 +1,5 @@
+"""Decomposition: clip-to-vector transformers from the clips' singular vectors."""
+
+from skmotion.decomposition._svd_features import SVDFeatureExtractor
+
+__all__ = ["SVDFeatureExtractor"]
