@@ -3,7 +3,50 @@
 import numpy as np
 
 from _common import SHARED_DATA
-from skmotion.datasets import load_uea, make_repeated_motions
+from skmotion.datasets import load_cmu_asfamc, load_uea, make_repeated_motions
+from skmotion.preprocessing import to_markers
+
+_ROOT_CHANNELS = 6  # CMU ASF root: TX TY TZ RX RY RZ (where the subject is and faces)
+
+
+def cut_repeats(clips, frame_rate, *, n_repeats=5, duration=(1.0, 2.0), random_state=0):
+    """The first ``n_repeats`` consecutive segments of each clip, of random durations.
+
+    Returns the segments and, per segment, the index of the clip it was cut
+    from (its label). A clip too short for ``n_repeats`` segments gives fewer.
+    """
+    rng = np.random.default_rng(random_state)
+    segments, labels = [], []
+    for label, clip in enumerate(clips):
+        lengths = np.round(rng.uniform(*duration, size=n_repeats) * frame_rate).astype(int)
+        ends = np.cumsum(lengths)
+        for start, end in zip(ends - lengths, ends[ends <= len(clip)]):
+            segments.append(clip[start:end])
+            labels.append(label)
+    return segments, np.asarray(labels)
+
+
+def cmu_repeats():
+    """name -> (segments, labels): CMU trials cut into repeated segments.
+
+    The 28 trials of CMU subjects 01-03 in ``../shared/data/cmu-asfamc``; each
+    trial's first five consecutive segments of 1-2 s are its "repetitions"
+    (similar = the same trial, the paper's set-up of a motion performed five
+    times). Two representations of the same segments: joint angles without the
+    root's six channels (59 channels, radians), and virtual markers (192
+    channels: body-frame positions and velocities of 32 markers).
+    """
+    folder = SHARED_DATA / "cmu-asfamc"
+    if not folder.is_dir():
+        print(f"CMU: not found in {SHARED_DATA}, left out")
+        return {}
+    data = load_cmu_asfamc(folder, index=SHARED_DATA / "cmu-index.csv")
+    markers, _ = to_markers(data.motions)
+    angles = [c[:, _ROOT_CHANNELS:] for c in data.clips]
+    return {
+        "CMU repeats, joint angles": cut_repeats(angles, data.frame_rate),
+        "CMU repeats, virtual markers": cut_repeats(markers, data.frame_rate),
+    }
 
 
 def search_datasets():
@@ -11,7 +54,8 @@ def search_datasets():
 
     "synthetic repeated": 63 motions x 5 repetitions, pelvis-relative joint
     positions (similar = the same motion, the paper's set-up); "synthetic by
-    class": the same clips, similar = the same class (7 classes); the UEA sets
+    class": the same clips, similar = the same class (7 classes); the CMU
+    trials cut into repeated segments (:func:`cmu_repeats`); the UEA sets
     with similar = the same class (JapaneseVowels: the speaker).
     """
     data = make_repeated_motions(random_state=0)
@@ -19,6 +63,7 @@ def search_datasets():
         "synthetic repeated": (data.clips, data.target),
         "synthetic by class": (data.clips, data.motion_class),
     }
+    sets.update(cmu_repeats())
     for name in ("JapaneseVowels", "BasicMotions"):
         try:
             uea = load_uea(name, data_home=SHARED_DATA)

@@ -12,6 +12,7 @@ from skmotion.utils._sklearn_compat import Interval, validate_params
 
 __all__ = [
     "make_pruning_scorer",
+    "make_search_scorer",
     "pruning_efficiency",
     "pruning_scorer",
     "recall",
@@ -229,6 +230,11 @@ def recall_scorer(estimator, X, y):
     return _search_quality(estimator, X, y)[1]
 
 
+def _bounded(pruning, found, min_recall):
+    """Pruning efficiency while recall >= min_recall, else recall - 1 (negative)."""
+    return pruning if found >= min_recall else found - 1.0
+
+
 class _PruningAtRecall:
     """Pruning efficiency while recall >= min_recall, else recall - 1 (negative)."""
 
@@ -236,8 +242,7 @@ class _PruningAtRecall:
         self.min_recall = min_recall
 
     def __call__(self, estimator, X, y):
-        pruning, found = _search_quality(estimator, X, y)
-        return pruning if found >= self.min_recall else found - 1.0
+        return _bounded(*_search_quality(estimator, X, y), self.min_recall)
 
     def __repr__(self):
         return f"make_pruning_scorer(min_recall={self.min_recall!r})"
@@ -277,3 +282,57 @@ def make_pruning_scorer(min_recall=0.99):
     ['epsilon']
     """
     return _PruningAtRecall(min_recall)
+
+
+class _SearchScores:
+    """Pruning, recall and bounded pruning from one query pass, as a dict."""
+
+    def __init__(self, min_recall):
+        self.min_recall = min_recall
+
+    def __call__(self, estimator, X, y):
+        pruning, found = _search_quality(estimator, X, y)
+        return {"pruning": pruning, "recall": found, "pruning_at_recall": _bounded(pruning, found, self.min_recall)}
+
+    def __repr__(self):
+        return f"make_search_scorer(min_recall={self.min_recall!r})"
+
+
+@validate_params({"min_recall": [Interval(Real, 0, 1, closed="both")]}, prefer_skip_nested_validation=True)
+def make_search_scorer(min_recall=0.99):
+    """One scorer giving pruning, recall and the bounded pruning together.
+
+    ``GridSearchCV`` calls each scorer of a ``scoring`` dict on its own, so
+    :func:`pruning_scorer`, :func:`recall_scorer` and
+    :func:`make_pruning_scorer` side by side query the index (and run any
+    transformer before it) three times. This scorer queries once and returns
+    the three scores as a dict, which ``GridSearchCV(scoring=...)`` accepts:
+    ``refit="pruning_at_recall"`` refits the best bounded setting.
+
+    Parameters
+    ----------
+    min_recall : float, default=0.99
+        The recall bound of ``"pruning_at_recall"`` (see :func:`make_pruning_scorer`).
+
+    Returns
+    -------
+    scorer : callable
+        ``scorer(estimator, X, y) -> {"pruning": ..., "recall": ...,
+        "pruning_at_recall": ...}``.
+
+    Examples
+    --------
+    >>> from sklearn.model_selection import GridSearchCV
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.metrics import make_search_scorer
+    >>> from skmotion.neighbors import IntervalIndexNeighbors
+    >>> data = make_motions(n_clips_per_class=6, random_state=0)
+    >>> clips = [c[:, 6:] for c in data.clips]
+    >>> search = GridSearchCV(
+    ...     IntervalIndexNeighbors(n_levels=4), {"epsilon": [0.6, 1.2]},
+    ...     scoring=make_search_scorer(0.9), refit="pruning_at_recall", cv=3,
+    ... ).fit(clips, data.target)
+    >>> sorted(k for k in search.cv_results_ if k.startswith("mean_test"))
+    ['mean_test_pruning', 'mean_test_pruning_at_recall', 'mean_test_recall']
+    """
+    return _SearchScores(min_recall)

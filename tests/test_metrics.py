@@ -6,7 +6,14 @@ from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import FunctionTransformer
 
 from skmotion.datasets import make_repeated_motions
-from skmotion.metrics import make_pruning_scorer, pruning_efficiency, pruning_scorer, recall, recall_scorer
+from skmotion.metrics import (
+    make_pruning_scorer,
+    make_search_scorer,
+    pruning_efficiency,
+    pruning_scorer,
+    recall,
+    recall_scorer,
+)
 from skmotion.neighbors import IntervalIndexNeighbors
 
 Y_STORED = np.array(["a", "a", "a", "b", "b", "c"])
@@ -75,3 +82,18 @@ def test_bounded_scorer_rewards_pruning_only_at_the_recall_bound(fitted):
     assert make_pruning_scorer(min_recall=found)(index, X_test, y_test) == pruning
     assert make_pruning_scorer(min_recall=min(1.0, found + 0.01))(index, X_test, y_test) == pytest.approx(found - 1)
     assert "min_recall=0.9" in repr(make_pruning_scorer(0.9))
+
+
+def test_search_scorer_gives_the_three_scores_at_once(fitted):
+    y_train, X_train, y_test, X_test = fitted
+    for epsilon in (0.5, 1.0):
+        index = IntervalIndexNeighbors(n_levels=5, epsilon=epsilon).fit(X_train, y_train)
+        scores = make_search_scorer(0.9)(index, X_test, y_test)
+        assert scores == {
+            "pruning": pruning_scorer(index, X_test, y_test),
+            "recall": recall_scorer(index, X_test, y_test),
+            "pruning_at_recall": make_pruning_scorer(0.9)(index, X_test, y_test),
+        }
+    assert "min_recall=0.8" in repr(make_search_scorer(0.8))
+    with pytest.raises(ValueError, match="min_recall"):
+        make_search_scorer(-0.1)

@@ -3,9 +3,10 @@
 Both the SVD feature vectors and the similarity psi need, for each clip ``A``
 (``n_frames x n_channels``), the singular values and the leading right singular
 vectors. For the usual clip (more frames than channels) they come from the
-``n_channels x n_channels`` Gram matrix ``A^T A``, whose eigen-decomposition is
-batched over clips; a clip with fewer frames than channels takes a thin SVD,
-which is cheaper there. Nothing loops over frames.
+``n_channels x n_channels`` Gram matrix ``A^T A``; for a clip with fewer frames
+than channels, from the smaller ``n_frames x n_frames`` matrix ``A A^T``. Clips
+whose matrices have one size are decomposed in one batched call. Nothing loops
+over frames.
 """
 
 import numpy as np
@@ -45,20 +46,25 @@ def _rank_tolerance(eigenvalues):
 
 def _spectra_of_chunk(chunk, n_vectors):
     n = chunk[0].shape[1]
-    n_clips = len(chunk)
-    eigenvalues = np.zeros((n_clips, n))
-    vectors = np.zeros((n_clips, n, n_vectors))
-    tall = [i for i, c in enumerate(chunk) if len(c) >= n]
-    if tall:
-        gram = np.stack([chunk[i].T @ chunk[i] for i in tall]).astype(np.float64, copy=False)
-        values, vecs = np.linalg.eigh(gram)  # ascending
-        eigenvalues[tall] = values[:, ::-1]
-        vectors[tall] = vecs[:, :, ::-1][:, :, :n_vectors]
-    for i in (i for i, c in enumerate(chunk) if len(c) < n):
-        _, s, vt = np.linalg.svd(np.asarray(chunk[i], dtype=np.float64), full_matrices=False)
-        eigenvalues[i, : len(s)] = s**2
-        m = min(len(s), n_vectors)
-        vectors[i, :, :m] = vt[:m].T
+    eigenvalues = np.zeros((len(chunk), n))
+    vectors = np.zeros((len(chunk), n, n_vectors))
+    # The smaller Gram matrix of each clip: A^T A (channels x channels), or A A^T
+    # (frames x frames) for a clip with fewer frames than channels. Clips whose
+    # Gram matrices have one size are decomposed in one batched call.
+    sizes = np.array([min(len(c), n) for c in chunk])
+    for size in np.unique(sizes):
+        rows = np.flatnonzero(sizes == size)
+        clips = [np.asarray(chunk[i], dtype=np.float64) for i in rows]
+        tall = size == n
+        values, vecs = np.linalg.eigh(np.stack([c.T @ c if tall else c @ c.T for c in clips]))
+        values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
+        if not tall:
+            # Right singular vectors from the left ones: v = A^T w / |A^T w|.
+            vecs = np.stack([c.T @ w for c, w in zip(clips, vecs)])
+            norms = np.linalg.norm(vecs, axis=1, keepdims=True)
+            vecs = np.divide(vecs, norms, out=np.zeros_like(vecs), where=norms > 0)
+        eigenvalues[rows, :size] = values
+        vectors[rows, :, : vecs.shape[2]] = vecs
     eigenvalues = np.clip(eigenvalues, 0.0, None)
     # Directions beyond a clip's rank are undefined: make them zero vectors, so
     # that every caller treats them the same whichever route computed them.

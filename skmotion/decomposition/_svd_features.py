@@ -90,9 +90,10 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
     rules agree; for ``"first_two"`` the first fixes the sign of ``u_2``
     relative to ``u_1``, which the paper leaves open.
 
-    The per-clip SVDs come from the ``n_channels x n_channels`` Gram matrix
-    (batched eigen-decomposition) or, for clips with fewer frames than channels,
-    a thin SVD. An all-zero clip has no singular vector and is rejected.
+    The per-clip SVDs come from the ``n_channels x n_channels`` Gram matrix or,
+    for clips with fewer frames than channels, the smaller ``n_frames x
+    n_frames`` one (batched eigen-decompositions). An all-zero clip has no
+    singular vector and is rejected.
 
     References
     ----------

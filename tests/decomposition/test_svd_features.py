@@ -63,7 +63,7 @@ def reference_features(train, test, r, weighting):
 def test_matches_svd_reference(weighting):
     clips, _ = _data()
     rng = np.random.default_rng(1)
-    # Ragged, and two clips with fewer frames than channels (the thin-SVD route).
+    # Ragged, and two clips with fewer frames than channels (the frames x frames Gram route).
     others = [rng.normal(size=(n, clips[0].shape[1])) for n in (5, 30, 90)]
     extractor = SVDFeatureExtractor(n_components=5, weighting=weighting).fit(clips)
     np.testing.assert_allclose(
