@@ -33,8 +33,10 @@ def cmu_repeats():
     trial's first five consecutive segments of 1-2 s are its "repetitions"
     (similar = the same trial, the paper's set-up of a motion performed five
     times). Two representations of the same segments: joint angles without the
-    root's six channels (59 channels, radians), and virtual markers (192
-    channels: body-frame positions and velocities of 32 markers).
+    root's six channels (56 channels, radians), and virtual markers (192
+    channels: body-frame positions and velocities of 32 markers). A third set
+    keeps the joint angles of the 14 trials of subjects 02 and 03, each one
+    activity (walk, run, punch, swordplay, ...).
     """
     folder = SHARED_DATA / "cmu-asfamc"
     if not folder.is_dir():
@@ -43,9 +45,18 @@ def cmu_repeats():
     data = load_cmu_asfamc(folder, index=SHARED_DATA / "cmu-index.csv")
     markers, _ = to_markers(data.motions)
     angles = [c[:, _ROOT_CHANNELS:] for c in data.clips]
+    # Subject 01's playground trials change activity every few seconds (climb,
+    # hang, swing, jump down): their segments are not repetitions of one motion.
+    steady = [k for k, t in enumerate(data.trials) if not t.startswith("01_")]
+
+    def by_trial(clips, trials):  # labelled by trial id ("02_05")
+        segments, labels = cut_repeats(clips, data.frame_rate)
+        return segments, np.asarray(trials)[labels]
+
     return {
-        "CMU repeats, joint angles": cut_repeats(angles, data.frame_rate),
-        "CMU repeats, virtual markers": cut_repeats(markers, data.frame_rate),
+        "CMU repeats, joint angles": by_trial(angles, data.trials),
+        "CMU repeats, virtual markers": by_trial(markers, data.trials),
+        "CMU repeats, joint angles, one-activity trials": by_trial([angles[k] for k in steady], data.trials[steady]),
     }
 
 

@@ -4,10 +4,14 @@ Collections of 1k to 100k synthetic clips (2-4 s windows of long synthetic
 performances, 75 channels). For each: the time to fit, the time to insert one
 more clip (feature extraction + tree insertion, median and worst of 200 single
 insertions; the paper: under 35 ms), and the memory of the tree (node tables and
-leaf blocks) and of the stored psi signatures. A log-log fit gives the growth
-exponents. Run: ``python benchmarks/bench_neighbors_scale.py``.
+leaf blocks), of the stored psi signatures and of the whole process (peak
+resident set). Fit is split into its parts: the tree is rebuilt alone from the
+stored feature vectors (``tree_build_s``), the rest is the per-clip SVDs and
+the feature projection. A log-log fit gives the growth exponents.
+Run: ``python benchmarks/bench_neighbors_scale.py`` (``--sizes 1000,3000`` for fewer).
 """
 
+import resource
 import sys
 import time
 from pathlib import Path
@@ -19,20 +23,34 @@ from _common import write_results  # noqa: E402
 from _motion_data import crop_pool  # noqa: E402
 
 from skmotion.neighbors import IntervalIndexNeighbors  # noqa: E402
+from skmotion.neighbors._interval_index import IntervalIndex  # noqa: E402
 
 SIZES = (1_000, 3_000, 10_000, 30_000, 100_000)
 N_INSERTS = 200
 PARAMS = {"n_levels": 7, "epsilon": 0.8}
 
 
-def main():
-    clips, labels = crop_pool(max(SIZES) + N_INSERTS, random_state=1)
+def tree_build_seconds(index):
+    """Time to build the tree alone (same entries and radii) from the stored feature vectors."""
+    tree = index._tree_features
+    start = time.perf_counter()
+    IntervalIndex(index.index_.edges, index.index_.radius).insert(tree)
+    return time.perf_counter() - start
+
+
+def peak_rss_mb():
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e3  # Linux: kilobytes
+
+
+def main(sizes=SIZES):
+    clips, labels = crop_pool(max(sizes) + N_INSERTS, random_state=1)
     extra, extra_labels = clips[-N_INSERTS:], labels[-N_INSERTS:]
     rows = []
-    for n in SIZES:
+    for n in sizes:
         start = time.perf_counter()
         index = IntervalIndexNeighbors(**PARAMS).fit(clips[:n], labels[:n])
         fit_seconds = time.perf_counter() - start
+        tree_seconds = tree_build_seconds(index)
         tree_bytes = index.index_.nbytes()
         stored = index.index_.n_stored()
         signature_bytes = sum(a.nbytes for a in index._ranking)
@@ -45,6 +63,8 @@ def main():
             {
                 "clips": n,
                 "fit_s": fit_seconds,
+                "fit_us_per_clip": 1e6 * fit_seconds / n,
+                "tree_build_s": tree_seconds,
                 "insert_ms_median": 1e3 * float(np.median(times)),
                 "insert_ms_p99": 1e3 * float(np.quantile(times, 0.99)),
                 "insert_ms_max": 1e3 * max(times),
@@ -53,6 +73,7 @@ def main():
                 "tree_MB": tree_bytes / 1e6,
                 "tree_bytes_per_clip": tree_bytes / n,
                 "signatures_MB": signature_bytes / 1e6,
+                "peak_rss_MB": peak_rss_mb(),
             }
         )
         print(rows[-1], flush=True)
@@ -60,7 +81,7 @@ def main():
     sizes = np.log([r["clips"] for r in rows])
     slopes = {
         key: float(np.polyfit(sizes, np.log([r[key] for r in rows]), 1)[0])
-        for key in ("fit_s", "tree_MB", "leaves", "insert_ms_median")
+        for key in ("fit_s", "tree_build_s", "tree_MB", "signatures_MB", "leaves", "insert_ms_median")
     }
     notes = (
         f"{PARAMS['n_levels']} levels, epsilon {PARAMS['epsilon']}. Growth exponents (log-log slope over the sizes): "
@@ -71,4 +92,7 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    if "--sizes" in sys.argv:
+        main(tuple(int(v) for v in sys.argv[sys.argv.index("--sizes") + 1].split(",")))
+    else:
+        main()

@@ -21,14 +21,25 @@ def _orient(vector):
     return 1.0 if vector[np.argmax(np.abs(vector))] >= 0 else -1.0
 
 
+def _right_singular(matrix, n):
+    """The ``n`` leading right singular vectors (rows) and values of a tall matrix.
+
+    From the eigen-decomposition of the small ``matrix^T matrix``: the left
+    singular vectors, which a full SVD would also compute, are never needed,
+    and there is one per training clip.
+    """
+    values, vectors = np.linalg.eigh(matrix.T @ matrix)
+    return vectors[:, ::-1][:, :n].T, np.sqrt(np.clip(values[::-1][:n], 0.0, None))
+
+
 def _principal_axis(vectors):
     """First principal axis (uncentred) of unit vectors, with a fixed sign.
 
     ``sum_c v_c v_c^T`` does not change when any ``v_c`` flips sign, so the axis
     is a property of the vectors' directions alone.
     """
-    _, _, vt = np.linalg.svd(vectors, full_matrices=False)
-    return vt[0] * _orient(vt[0])
+    axis = _right_singular(vectors, 1)[0][0]
+    return axis * _orient(axis)
 
 
 class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
@@ -196,10 +207,9 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
             )
         self.axes_ = np.stack([_principal_axis(vectors[:, :, i]) for i in range(n_vectors)])
         composite = self._composite(eigenvalues, vectors)
-        _, singular, vt = np.linalg.svd(composite, full_matrices=False)
-        components = vt[: self.n_components]
+        components, singular = _right_singular(composite, self.n_components)
         self.components_ = components * np.array([_orient(row) for row in components])[:, None]
-        self.singular_values_ = singular[: self.n_components]
+        self.singular_values_ = singular
         return self
 
     def _transform_spectra(self, eigenvalues, vectors):

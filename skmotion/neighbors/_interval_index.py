@@ -22,6 +22,7 @@ are vectorised over a batch: one ``searchsorted`` and one fancy index per level.
 """
 
 import math
+from bisect import bisect_right
 
 import numpy as np
 
@@ -110,6 +111,7 @@ class IntervalIndex:
             if e.ndim != 1 or (np.diff(e) <= 0).any():
                 raise ValueError(f"edges of level {level} must be a strictly increasing 1-D array.")
         self.n_entries = [len(e) + 1 for e in self.edges]
+        self._edge_lists = [e.tolist() for e in self.edges]  # for bisect (one query)
         # Level 0 holds the dead node 0 and the root 1.
         self._tables = [np.zeros((2 if level == 0 else 1, n), dtype=np.int32) for level, n in enumerate(self.n_entries)]
         self._n_nodes = [2] + [1] * (self.n_levels - 1)
@@ -249,10 +251,23 @@ class IntervalIndex:
 
     def leaf_of(self, vectors):
         """The leaf each query reaches, one node per level (0: an empty leaf)."""
+        vectors = self._check(vectors)
+        if len(vectors) == 1:
+            return np.array([self._leaf_of_one(vectors[0].tolist())], dtype=np.intp)
+        return self._leaf_of_batch(vectors)
+
+    def _leaf_of_batch(self, vectors):
         entries = self.query_entries(vectors)
         node = np.ones(len(entries), dtype=np.intp)
         for level, table in enumerate(self._tables):
             node = table[node, entries[:, level]]
+        return node
+
+    def _leaf_of_one(self, vector):
+        """The leaf of one query given as a list: ``bisect_right`` is ``searchsorted(side="right")``."""
+        node = 1
+        for edges, table, value in zip(self._edge_lists, self._tables, vector):
+            node = table.item(node, bisect_right(edges, value))
         return node
 
     def leaf_items(self, leaf):

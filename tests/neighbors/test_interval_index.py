@@ -134,3 +134,22 @@ def test_large_insertions_are_split_and_agree(monkeypatch):
     for a, b in zip(whole.candidates(queries), pieces.candidates(queries)):
         np.testing.assert_array_equal(a, b)
     assert whole.n_nodes == pieces.n_nodes
+
+
+@given(st.integers(0, 10_000), st.integers(1, 5), st.sampled_from([2, 5, 64]))
+def test_one_query_path_equals_the_batched_path(seed, n_levels, max_entries):
+    rng = np.random.default_rng(seed)
+    items = rng.normal(size=(60, n_levels))
+    radius = rng.uniform(0.0, 0.5, size=n_levels)
+    edges = [entry_edges(items[:, i].min(), items[:, i].max(), 0.3, max_entries) for i in range(n_levels)]
+    index = IntervalIndex(edges, radius)
+    index.insert(items[:40])
+    # Queries: random, far outside the range, and exactly on entry boundaries.
+    on_edges = np.stack([rng.choice(e, size=10) if len(e) else np.zeros(10) for e in edges], axis=1)
+    queries = np.vstack([rng.normal(size=(20, n_levels)) * 2, on_edges, items[40:] * 10])
+    batched = index._leaf_of_batch(queries)
+    one_by_one = np.concatenate([index.leaf_of(q[None]) for q in queries])
+    np.testing.assert_array_equal(one_by_one, batched)
+    # Still equal after more items grew the tables.
+    index.insert(items[40:])
+    np.testing.assert_array_equal([index.leaf_of(q[None])[0] for q in queries], index._leaf_of_batch(queries))
