@@ -22,12 +22,16 @@ def _orient(vector):
 
 
 def _right_singular(matrix, n):
-    """The ``n`` leading right singular vectors (rows) and values of a tall matrix.
+    """The ``n`` leading right singular vectors (rows) and singular values of a matrix.
 
-    From the eigen-decomposition of the small ``matrix^T matrix``: the left
-    singular vectors, which a full SVD would also compute, are never needed,
-    and there is one per training clip.
+    With more rows (training clips) than columns, from the eigen-decomposition
+    of the small ``matrix^T matrix``: the left singular vectors, one entry per
+    clip, which an SVD would also compute, are never needed. Otherwise an SVD,
+    whose cost then follows the number of rows.
     """
+    if matrix.shape[0] <= matrix.shape[1]:
+        _, singular, vt = np.linalg.svd(matrix, full_matrices=False)
+        return vt[:n], singular[:n]
     values, vectors = np.linalg.eigh(matrix.T @ matrix)
     return vectors[:, ::-1][:, :n].T, np.sqrt(np.clip(values[::-1][:n], 0.0, None))
 
