@@ -1,0 +1,48 @@
+"""clip_spectra (both Gram routes, batched by size) against numpy's SVD of each clip."""
+
+import numpy as np
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from skmotion.decomposition._clip_svd import clip_spectra
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 10_000), st.integers(2, 9), st.integers(1, 4))
+def test_matches_the_svd_of_every_clip(seed, n_channels, n_vectors):
+    rng = np.random.default_rng(seed)
+    # Lengths on both sides of n_channels, repeated so that clips share a batch,
+    # and one rank-deficient clip (a repeated frame pattern).
+    lengths = rng.integers(1, 2 * n_channels + 2, size=12)
+    clips = [rng.normal(size=(n, n_channels)) * rng.uniform(0.5, 3.0, size=n_channels) for n in lengths]
+    clips.append(np.tile(rng.normal(size=(1, n_channels)), (5, 1)))
+    n_vectors = min(n_vectors, n_channels)
+    eigenvalues, vectors = clip_spectra(clips, n_vectors)
+    for clip, values, vecs in zip(clips, eigenvalues, vectors):
+        _, s, vt = np.linalg.svd(clip)
+        rank = int(np.sum(s > s[0] * 1e-10))
+        expected = np.zeros(n_channels)
+        expected[:rank] = s[:rank] ** 2
+        np.testing.assert_allclose(values, expected, rtol=1e-9, atol=1e-9 * s[0] ** 2)
+        for i in range(n_vectors):
+            if i >= rank:
+                np.testing.assert_array_equal(vecs[:, i], 0.0)
+                continue
+            gaps = np.abs(s[i] ** 2 - np.delete(s[:rank] ** 2, i))
+            if gaps.min(initial=np.inf) < 1e-6 * s[0] ** 2:
+                continue  # a repeated singular value: the vector is not unique
+            # Unit vectors equal up to sign.
+            np.testing.assert_allclose(abs(vecs[:, i] @ vt[i]), 1.0, atol=1e-7)
+
+
+def test_chunks_and_jobs_give_the_same_spectra():
+    rng = np.random.default_rng(0)
+    clips = [rng.normal(size=(n, 6)) for n in rng.integers(2, 12, size=1100)]  # three chunks
+    one = clip_spectra(clips, 3)
+    two = clip_spectra(clips, 3, n_jobs=2)
+    for a, b in zip(one, two):
+        np.testing.assert_array_equal(a, b)
+    # A clip's spectrum does not depend on the clips beside it.
+    alone = clip_spectra(clips[700:701], 3)
+    np.testing.assert_array_equal(alone[0][0], one[0][700])
+    np.testing.assert_array_equal(alone[1][0], one[1][700])
