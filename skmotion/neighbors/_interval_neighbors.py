@@ -298,12 +298,13 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     def _store(self, tree_features, ranking, encoded):
         """Append clips' tree features, ranking data and labels to the stored ones."""
-        new = (tree_features, encoded, *(ranking if isinstance(ranking, tuple) else (ranking,)))
+        labels = self.classes_[encoded]
+        new = (tree_features, encoded, labels, *(ranking if isinstance(ranking, tuple) else (ranking,)))
         old = self._buffers or (None,) * len(new)
         n = self.n_samples_fit_
         self._buffers = tuple(_extend(b, n, a) for b, a in zip(old, new))
         self.n_samples_fit_ = n + len(tree_features)
-        self.labels_ = self.classes_[self._encoded]
+        self.labels_ = self._buffers[2][: self.n_samples_fit_]  # a view: O(1) per insertion
 
     @property
     def _tree_features(self):
@@ -316,7 +317,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     @property
     def _ranking(self):
         """Signatures (weights, vectors) for psi, or the feature vectors."""
-        parts = tuple(b[: self.n_samples_fit_] for b in self._buffers[2:])
+        parts = tuple(b[: self.n_samples_fit_] for b in self._buffers[3:])
         return parts if self.effective_metric_ == "psi" else parts[0]
 
     def insert(self, X, y):
