@@ -9,7 +9,9 @@ __version__ = "0.1.0"
 
 _SUBPACKAGES = (
     "base",
+    "control",
     "datasets",
+    "decomposition",
     "io",
     "kinematics",
     "preprocessing",
