@@ -10,7 +10,10 @@ from types import SimpleNamespace
 
 __all__ = ["SECTIONS", "run_demo"]
 
-SECTIONS = ("skmotion._demo.data",)
+SECTIONS = (
+    "skmotion._demo.data",
+    "skmotion._demo.primitives",
+)
 
 
 def run_demo(write, *, random_state=0, sections=SECTIONS):

@@ -3,12 +3,11 @@
 from numbers import Integral, Real
 
 import numpy as np
-from scipy.linalg import eigh
 from sklearn.base import BaseEstimator, TransformerMixin
-from sklearn.utils.extmath import svd_flip
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
+from skmotion.decomposition._principal_axes import principal_axes
 from skmotion.decomposition._segment_vectors import (
     assemble_segments,
     check_segments,
@@ -17,42 +16,13 @@ from skmotion.decomposition._segment_vectors import (
     segment_vectors,
     vectors_to_segments,
 )
-from skmotion.preprocessing._filter import filter_min_frames, lowpass_filter
-from skmotion.preprocessing._segment import energy_segments, zvc_segments
+from skmotion.preprocessing._filter import filter_min_frames
+from skmotion.preprocessing._segment import segment_clip
 from skmotion.utils._clips import check_clips, to_container
 from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["EigenMovementPCA"]
-
-
-def _principal_axes(vectors, n_components):
-    """Mean, the first eigenvectors (rows) and all eigenvalues of the covariance.
-
-    The covariance divides by the number of segments (the paper's eq. 3), so the
-    mean squared error of projecting the training segments on the first ``k``
-    eigenvectors is exactly the sum of the other eigenvalues. The symmetric
-    eigenproblem is solved on the smaller of the covariance ``(D, D)`` and the
-    Gram matrix ``(N, N)`` of the centred vectors; when the segments span fewer
-    than ``n_components`` directions, an SVD completes the basis.
-    """
-    n_segments, n_features = vectors.shape
-    mean = vectors.mean(axis=0)
-    centred = vectors - mean
-    if n_segments >= n_features:
-        eigenvalues, axes = eigh(centred.T @ centred)
-        eigenvalues, axes = eigenvalues[::-1], axes[:, ::-1].T
-    else:
-        eigenvalues, u = eigh(centred @ centred.T)
-        eigenvalues, u = eigenvalues[::-1], u[:, ::-1]
-        rank = int((eigenvalues > eigenvalues[0] * n_segments * np.finfo(float).eps).sum())
-        if rank >= n_components:
-            axes = (centred.T @ u[:, :n_components] / np.sqrt(eigenvalues[:n_components])).T
-        else:
-            axes = np.linalg.svd(centred, full_matrices=False)[2]
-    axes = axes[:n_components]
-    _, axes = svd_flip(np.zeros((1, len(axes))), axes, u_based_decision=False)
-    return mean, axes, np.clip(eigenvalues, 0.0, None) / n_segments
 
 
 class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator):
@@ -227,22 +197,16 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator):
     def _segments_of(self, clip):
         if self.segmentation == "none":
             return np.array([[0, len(clip)]], dtype=np.intp)
-        signal = clip
-        if self.filter_order is not None:
-            signal = lowpass_filter(clip, order=self.filter_order, cutoff=self.filter_cutoff)
-        if self.segmentation == "zvc":
-            return zvc_segments(
-                signal,
-                frame_rate=self.frame_rate,
-                window=self.zvc_window,
-                min_channels=self.zvc_min_channels,
-                min_movement=self.min_movement,
-            )
-        return energy_segments(
-            signal,
-            threshold=self.energy_threshold,
-            ratio=self.energy_ratio,
+        return segment_clip(
+            clip,
+            rule=self.segmentation,
             frame_rate=self.frame_rate,
+            filter_order=self.filter_order,
+            filter_cutoff=self.filter_cutoff,
+            energy_threshold=self.energy_threshold,
+            energy_ratio=self.energy_ratio,
+            zvc_window=self.zvc_window,
+            zvc_min_channels=self.zvc_min_channels,
             min_movement=self.min_movement,
         )
 
@@ -260,19 +224,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator):
 
     # -- fitting -----------------------------------------------------------------------
 
-    def _check_frame_rate(self):
-        needs = self.segmentation == "zvc" or (
-            self.segmentation == "energy" and self.energy_threshold is not None
-        )
-        if needs and self.frame_rate is None:
-            what = "segmentation='zvc'" if self.segmentation == "zvc" else "an explicit energy_threshold"
-            raise ValueError(
-                f"{what} needs frame_rate (frames per second); loaders report it, e.g. "
-                "make_motions(...).frame_rate."
-            )
-
     def _fit(self, X):
-        self._check_frame_rate()
         clips = check_clips(X, estimator=self, reset=True, min_frames=self._min_frames())
         segments = self._segment_all(clips)
         per_clip = self._vectors_all(clips, segments)
@@ -291,7 +243,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator):
                 f"min({n_segments}, {n_features}) = {limit}: the {len(clips)} training clips "
                 f"gave {n_segments} segments."
             )
-        mean, axes, eigenvalues = _principal_axes(vectors, n_components)
+        mean, axes, eigenvalues = principal_axes(vectors, n_components)
         self.mean_ = mean
         self.components_ = axes
         self.explained_variance_ = eigenvalues[:n_components]

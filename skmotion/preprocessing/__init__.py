@@ -7,6 +7,7 @@ from skmotion.preprocessing._segment import (
     SEGMENTATION_RULES,
     energy_segments,
     movement_energy,
+    segment_clip,
     zero_velocity_crossings,
     zvc_segments,
 )
@@ -21,6 +22,7 @@ __all__ = [
     "lowpass_filter",
     "movement_energy",
     "resample_clip",
+    "segment_clip",
     "zero_velocity_crossings",
     "zvc_segments",
 ]

@@ -9,10 +9,13 @@ their boundary frame.
 import numpy as np
 from scipy.signal import find_peaks
 
+from skmotion.preprocessing._filter import lowpass_filter
+
 __all__ = [
     "SEGMENTATION_RULES",
     "energy_segments",
     "movement_energy",
+    "segment_clip",
     "zvc_segments",
     "zero_velocity_crossings",
 ]
@@ -255,3 +258,74 @@ def energy_segments(clip, *, threshold=None, ratio=0.1, frame_rate=None, min_mov
     left_stops = np.r_[0, np.flatnonzero(~falls_left) + 1]
     start = left_stops[np.searchsorted(left_stops, run_starts, side="right") - 1]
     return _keep_moving(clip, _as_segments(np.c_[start, stop + 1]), min_movement)
+
+
+def segment_clip(
+    clip,
+    *,
+    rule="energy",
+    frame_rate=None,
+    filter_order=10,
+    filter_cutoff=0.25,
+    energy_threshold=None,
+    energy_ratio=0.1,
+    zvc_window=0.3,
+    zvc_min_channels=2,
+    min_movement=0.0,
+):
+    """Low-pass filter a clip, then cut it by one of the segmentation rules.
+
+    The filter only steers the boundaries: the segments are frame ranges, to be
+    cut from the clip itself.
+
+    Parameters
+    ----------
+    clip : ndarray of shape (n_frames, n_channels)
+        The clip, time first.
+    rule : {"energy", "zvc"}, default="energy"
+        :func:`energy_segments` (SEG-2) or :func:`zvc_segments` (SEG-1).
+    frame_rate : float, default=None
+        Frames per second; needed by ``"zvc"`` and by an explicit
+        ``energy_threshold``.
+    filter_order : int or None, default=10
+        Order of the zero-phase Butterworth low-pass (:func:`lowpass_filter`);
+        ``None`` for no filter.
+    filter_cutoff : float, default=0.25
+        Its cutoff, as a fraction of the Nyquist frequency.
+    energy_threshold, energy_ratio : float
+        ``threshold`` and ``ratio`` of :func:`energy_segments`.
+    zvc_window, zvc_min_channels : float, int
+        ``window`` and ``min_channels`` of :func:`zvc_segments`.
+    min_movement : float, default=0.0
+        Movement a segment must exceed, in the clip's units.
+
+    Returns
+    -------
+    segments : ndarray of int of shape (n_segments, 2)
+        ``(start, stop)`` of each segment.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.preprocessing import segment_clip
+    >>> t = np.arange(150) / 30
+    >>> clip = np.c_[np.cos(np.pi * t), 2 * np.cos(np.pi * t)]
+    >>> segment_clip(clip, rule="zvc", frame_rate=30, filter_order=4).tolist()
+    [[30, 61], [60, 91], [90, 121]]
+    """
+    if rule not in SEGMENTATION_RULES:
+        raise ValueError(f"rule must be one of {list(SEGMENTATION_RULES)}; got {rule!r}.")
+    if frame_rate is None and (rule == "zvc" or energy_threshold is not None):
+        what = "segmentation='zvc'" if rule == "zvc" else "an explicit energy_threshold"
+        raise ValueError(
+            f"{what} needs frame_rate (frames per second); loaders report it, e.g. "
+            "make_motions(...).frame_rate."
+        )
+    signal = clip if filter_order is None else lowpass_filter(clip, order=filter_order, cutoff=filter_cutoff)
+    if rule == "zvc":
+        return zvc_segments(
+            signal, frame_rate=frame_rate, window=zvc_window, min_channels=zvc_min_channels, min_movement=min_movement
+        )
+    return energy_segments(
+        signal, threshold=energy_threshold, ratio=energy_ratio, frame_rate=frame_rate, min_movement=min_movement
+    )
