@@ -160,14 +160,17 @@ class ArmModel:
 
     @property
     def n_dof(self):
+        """Number of hinges."""
         return sum(len(h) for h in self.hinges)
 
     @property
     def lengths(self):
+        """Link lengths, metres."""
         return np.linalg.norm(self.links, axis=1)
 
     @property
     def masses(self):
+        """Link masses, kg (solid cylinders of the arm's density)."""
         return self.density * np.pi * self.radii**2 * self.lengths
 
     def to_mjcf(self, *, kp, kd, timestep=0.001):

@@ -174,6 +174,13 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
         offsets = np.cumsum([0] + [len(c) for c in codes])
         return [values[a:b] for a, b in zip(offsets[:-1], offsets[1:])]
 
+    def _labels(self, codes):
+        """The nearest centre of every segment of every clip, stacked."""
+        return _squared_distances(np.concatenate(codes), self.cluster_centers_)[1]
+
+    def _quantized(self, codes):
+        return self._per_clip(codes, self.cluster_centers_[self._labels(codes)])
+
     def predict(self, X):
         """The primitive of each segment of each clip.
 
@@ -189,8 +196,7 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
         """
         check_is_fitted(self)
         codes = self._codes(X)
-        _, labels = _squared_distances(np.concatenate(codes), self.cluster_centers_)
-        return self._per_clip(codes, labels)
+        return self._per_clip(codes, self._labels(codes))
 
     def transform(self, X):
         """Primitive-usage histogram of each clip.
@@ -208,7 +214,7 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
         """
         check_is_fitted(self)
         codes = self._codes(X)
-        _, labels = _squared_distances(np.concatenate(codes), self.cluster_centers_)
+        labels = self._labels(codes)
         clip_of = np.repeat(np.arange(len(codes)), [len(c) for c in codes])
         usage = np.zeros((len(codes), self.n_clusters))
         np.add.at(usage, (clip_of, labels), 1.0)
@@ -232,9 +238,7 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
             them with ``EigenMovementPCA.inverse_transform``.
         """
         check_is_fitted(self)
-        codes = self._codes(X)
-        _, labels = _squared_distances(np.concatenate(codes), self.cluster_centers_)
-        return self._per_clip(codes, self.cluster_centers_[labels])
+        return self._quantized(self._codes(X))
 
     def score(self, X, y=None):
         """Negative clustering MSE: mean squared distance of codes to their primitive.
@@ -318,8 +322,7 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
                 f"has {arm.n_dof} joints."
             )
         if quantize:
-            _, labels = _squared_distances(np.concatenate(codes), self.cluster_centers_)
-            codes = self._per_clip(codes, self.cluster_centers_[labels])
+            codes = self._quantized(codes)
         targets = eigenmovements.inverse_transform(list(codes), segments)
         return [self._execute(t, arm, frame_rate, degrees, servo) for t in targets]
 

@@ -25,7 +25,7 @@ from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 __all__ = ["EigenMovementPCA"]
 
 
-class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator):
+class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None):
     """Eigenmovements: PCA of movement segments, each coded by a few numbers.
 
     Each clip is cut into segments (strokes from rest to rest), each segment is
@@ -248,7 +248,8 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator):
         self.components_ = axes
         self.explained_variance_ = eigenvalues[:n_components]
         self.total_variance_ = float(np.einsum("ij,ij->", vectors - mean, vectors - mean) / n_segments)
-        self.explained_variance_ratio_ = self.explained_variance_ / self.total_variance_
+        total = self.total_variance_
+        self.explained_variance_ratio_ = self.explained_variance_ / total if total > 0 else np.zeros(n_components)
         self.projection_mse_ = float(eigenvalues[n_components:].sum())
         self.projection_rms_ = float(np.sqrt(self.projection_mse_ / n_features))
         self.n_components_ = n_components
