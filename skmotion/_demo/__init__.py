@@ -12,11 +12,12 @@ __all__ = ["SECTIONS", "run_demo"]
 
 SECTIONS = (
     "skmotion._demo.data",
+    "skmotion._demo.markers",
     "skmotion._demo.primitives",
 )
 
 
-def run_demo(write, *, random_state=0, sections=SECTIONS):
+def run_demo(write, *, random_state=0, sections=SECTIONS, **options):
     """Run the demo sections in order, passing each line to ``write``.
 
     Parameters
@@ -27,13 +28,15 @@ def run_demo(write, *, random_state=0, sections=SECTIONS):
         Seed of the synthetic data and of every estimator.
     sections : sequence of str, default=SECTIONS
         Modules of the sections to run.
+    **options
+        Set on the context for the sections (``data_folder``, ``frame_rate``).
 
     Returns
     -------
     context : SimpleNamespace
         What the sections computed (the data, fitted models, scores).
     """
-    context = SimpleNamespace(random_state=random_state)
+    context = SimpleNamespace(random_state=random_state, **options)
     for name in sections:
         module = importlib.import_module(name)
         write("")

@@ -1,8 +1,26 @@
 """Datasets: the built-in synthetic motions and humanoid skeleton; loaders of real data."""
 
+from skmotion.datasets._fetch import fetch_cmu_mocap
 from skmotion.datasets._home import get_data_home
 from skmotion.datasets._humanoid import humanoid_skeleton
+from skmotion.datasets._motion_files import (
+    load_bvh_folder,
+    load_cmu_asfamc,
+    load_motion_folder,
+    read_cmu_index,
+)
 from skmotion.datasets._synthetic import MOTION_CLASSES, make_motions
 from skmotion.datasets._uea import load_uea
 
-__all__ = ["MOTION_CLASSES", "get_data_home", "humanoid_skeleton", "load_uea", "make_motions"]
+__all__ = [
+    "MOTION_CLASSES",
+    "fetch_cmu_mocap",
+    "get_data_home",
+    "humanoid_skeleton",
+    "load_bvh_folder",
+    "load_cmu_asfamc",
+    "load_motion_folder",
+    "load_uea",
+    "make_motions",
+    "read_cmu_index",
+]

@@ -1,6 +1,22 @@
 """Reading and writing motion files."""
 
+from skmotion.io._amc import read_amc
+from skmotion.io._asf import acclaim_order, read_asf
+from skmotion.io._bvh import detect_up_axis, read_bvh
+from skmotion.io._bvh_write import write_bvh
 from skmotion.io._errors import MotionFileError
+from skmotion.io._motion import Motion, as_motions
 from skmotion.io._ts import read_ts
 
-__all__ = ["MotionFileError", "read_ts"]
+__all__ = [
+    "Motion",
+    "MotionFileError",
+    "acclaim_order",
+    "as_motions",
+    "detect_up_axis",
+    "read_amc",
+    "read_asf",
+    "read_bvh",
+    "read_ts",
+    "write_bvh",
+]

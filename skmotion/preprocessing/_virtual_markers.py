@@ -1,0 +1,409 @@
+"""VirtualMarkerTransform: joint-angle clips to body-frame virtual-marker clips."""
+
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import BaseEstimator, clone
+from sklearn.utils.validation import check_is_fitted
+
+from skmotion.base import ClipTransformerMixin, MotionTags
+from skmotion.io._motion import Motion
+from skmotion.kinematics import Skeleton
+from skmotion.preprocessing._body_frame import body_frame_features, body_size
+from skmotion.preprocessing._marker_presets import MARKER_NAMES, MARKER_PRESETS, marker_preset
+from skmotion.preprocessing._marker_set import MarkerSet
+from skmotion.utils._clips import check_clips
+from skmotion.utils._parallel import parallel_map
+from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
+
+__all__ = ["SIZE_CHAIN", "VirtualMarkerTransform", "to_markers"]
+
+#: The default chain of :func:`body_size`: ankle to head top along the body.
+SIZE_CHAIN = ("left_ankle", "left_knee", "left_hip", "pelvis", "spine", "chest", "neck", "head_top")
+_COMPONENTS = ("px", "py", "pz", "vx", "vy", "vz")
+
+
+class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
+    """Joint-angle clips to virtual-marker clips in a body-centred frame.
+
+    Each output frame holds, for every virtual marker, its position and
+    velocity ``(px, py, pz, vx, vy, vz)`` (paper 000, section III-A):
+
+    1. forward kinematics gives each marker's world position (a marker is a
+       point fixed on a joint's link, see :class:`MarkerSet`); its velocity
+       is the time derivative (central differences, ``frame_rate`` aware);
+    2. both are expressed in a frame with its origin on the floor below the
+       root marker, ``z`` up and ``x`` the subject's facing on the floor
+       (from a left and a right marker), ``y`` to the subject's left: this
+       removes horizontal travel and turning;
+    3. lengths are divided by the subject's size (:func:`body_size` along
+       ``size_markers``), so subjects of different size match.
+
+    Where the skeleton comes from:
+
+    - **a list of** :class:`~skmotion.io.Motion`: each clip uses its own
+      skeleton and frame rate (several subjects, several skeleton families);
+    - **plain arrays with** ``skeleton``: every clip uses that skeleton;
+    - **plain arrays with** ``skeleton=None``: the clips already hold 3-D
+      marker positions, ``3 * n_markers`` channels (Kinect-style trackers),
+      named by ``markers``; only steps 2-3 run.
+
+    With ``markers="auto"`` each skeleton gets its family's preset
+    (:func:`marker_preset`), so clips of different skeletons share the same
+    32 output markers.
+
+    Parameters
+    ----------
+    skeleton : Skeleton, default=None
+        The skeleton of plain-array clips; None for marker-position input (or
+        when every clip is a Motion).
+    markers : "auto", str, MarkerSet or list, default="auto"
+        With a skeleton: ``"auto"`` (the preset detected from the joint
+        names), a preset name from :data:`MARKER_PRESETS`, a
+        :class:`MarkerSet` or a list of ``(name, joint, offset)``. For marker
+        positions: the input markers' names, in channel order (``"auto"``
+        means :data:`MARKER_NAMES`).
+    root_marker : str or int, default="pelvis"
+        The marker the origin lies below.
+    facing_markers : tuple of (str or int), default=("left_hip", "right_hip")
+        A marker on the subject's left and one on the right; forward is
+        perpendicular to the line between them, on the floor.
+    size_markers : "auto", sequence of (str or int) or None, default="auto"
+        The chain whose length is the subject's size (``"auto"``:
+        :data:`SIZE_CHAIN`); None keeps the input's length unit.
+    floor : "lowest" or float, default="lowest"
+        The floor height in the world: the lowest marker over each clip, or a
+        given height (in the input's length unit).
+    up_axis : {"x", "y", "z"}, default=None
+        The world's vertical axis; None takes each skeleton's ``up_axis``
+        (``"y"`` for marker positions).
+    frame_rate : float, default=None
+        Frames per second of plain-array clips. Motions use their own rate;
+        if given, it must agree with theirs.
+    n_jobs : int, default=None
+        Clips transformed in parallel (joblib threads); None is serial.
+
+    Attributes
+    ----------
+    n_features_in_ : int
+        Number of input channels.
+    feature_names_in_ : ndarray of str
+        Input channel names, when fit saw a DataFrame with string columns.
+    marker_names_ : ndarray of str
+        The output markers, in order.
+    n_markers_ : int
+        Number of markers; the output has ``6 * n_markers_`` channels.
+
+    See Also
+    --------
+    MarkerSet : define your own markers.
+    marker_preset : the standard markers on a known skeleton.
+    skmotion.io.as_motions : give each clip of a dataset its own skeleton.
+
+    References
+    ----------
+    K. Yamane, Y. Yamaguchi and Y. Nakamura, "Human motion database with a
+    binary tree and node transition graphs", Autonomous Robots 30(1), 2011.
+
+    Examples
+    --------
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.io import as_motions
+    >>> from skmotion.preprocessing import VirtualMarkerTransform
+    >>> data = make_motions(n_clips_per_class=2, classes=["walk", "wave"], random_state=0)
+    >>> motions = as_motions(data.clips, data.skeletons, data.frame_rate)
+    >>> markers = VirtualMarkerTransform().fit(motions)
+    >>> out = markers.transform(motions)
+    >>> out[0].shape, markers.get_feature_names_out()[:3].tolist()
+    ((88, 192), ['head_top_px', 'head_top_py', 'head_top_pz'])
+    """
+
+    _parameter_constraints = {
+        "skeleton": [Skeleton, None],
+        "markers": [StrOptions({"auto", *MARKER_PRESETS}), MarkerSet, list, tuple],
+        "root_marker": [str, Integral],
+        "facing_markers": [tuple, list],
+        "size_markers": [StrOptions({"auto"}), tuple, list, None],
+        "floor": [StrOptions({"lowest"}), Real],
+        "up_axis": [StrOptions({"x", "y", "z"}), None],
+        "frame_rate": [Interval(Real, 0, None, closed="neither"), None],
+        "n_jobs": [Integral, None],
+    }
+    _motion_tags = MotionTags(output_kind="clips", min_frames=2)
+
+    def __init__(
+        self,
+        skeleton=None,
+        *,
+        markers="auto",
+        root_marker="pelvis",
+        facing_markers=("left_hip", "right_hip"),
+        size_markers="auto",
+        floor="lowest",
+        up_axis=None,
+        frame_rate=None,
+        n_jobs=None,
+    ):
+        self.skeleton = skeleton
+        self.markers = markers
+        self.root_marker = root_marker
+        self.facing_markers = facing_markers
+        self.size_markers = size_markers
+        self.floor = floor
+        self.up_axis = up_axis
+        self.frame_rate = frame_rate
+        self.n_jobs = n_jobs
+
+    # -- where each clip's skeleton, markers and frame rate come from -----------------
+    def _clip_sources(self, X, n_clips):
+        """Per clip: (skeleton or None, frame rate)."""
+        items = list(X) if isinstance(X, (list, tuple)) else [None] * n_clips
+        is_motion = [isinstance(item, Motion) for item in items]
+        if any(is_motion) and not all(is_motion) and self.skeleton is None:
+            plain = is_motion.index(False)
+            raise ValueError(
+                f"X: clip {plain} is a plain array while other clips are Motions; give skeleton= for "
+                "plain arrays, or make every clip a Motion."
+            )
+        sources = []
+        for i, (item, motion) in enumerate(zip(items, is_motion)):
+            if motion:
+                if self.frame_rate is not None and not np.isclose(item.frame_rate, self.frame_rate):
+                    raise ValueError(
+                        f"X: clip {i} is a Motion at {item.frame_rate:g} Hz, but frame_rate={self.frame_rate:g}."
+                    )
+                sources.append((item.skeleton, item.frame_rate))
+            else:
+                if self.frame_rate is None:
+                    raise ValueError(
+                        f"X: clip {i} is a plain array; give frame_rate= (Hz) for velocities, or pass Motions."
+                    )
+                sources.append((self.skeleton, float(self.frame_rate)))
+        return sources
+
+    def _marker_set(self, skeleton):
+        if isinstance(self.markers, MarkerSet):
+            return self.markers
+        if isinstance(self.markers, (list, tuple)):
+            return MarkerSet(self.markers)
+        return marker_preset(skeleton, None if self.markers == "auto" else self.markers)
+
+    def _input_marker_names(self, n_channels):
+        """Names of the markers of marker-position input (``skeleton=None``)."""
+        if n_channels % 3:
+            raise ValueError(
+                f"X has {n_channels} channels; marker positions (skeleton=None) need 3 per marker. Give "
+                "skeleton= for joint-angle clips."
+            )
+        if isinstance(self.markers, MarkerSet):
+            names = self.markers.names
+        elif isinstance(self.markers, str):
+            names = MARKER_NAMES
+        else:
+            names = tuple(str(m) for m in self.markers)
+        if len(names) != n_channels // 3:
+            raise ValueError(
+                f"X has {n_channels // 3} markers (3 channels each), but markers names {len(names)}; give the "
+                "input markers' names in channel order."
+            )
+        return tuple(names)
+
+    def _index(self, names, marker, what):
+        if isinstance(marker, (Integral, np.integer)):
+            if not 0 <= marker < len(names):
+                raise ValueError(f"{what} index {marker} is out of range for {len(names)} markers.")
+            return int(marker)
+        if marker not in names:
+            raise ValueError(f"{what} {marker!r} is not a marker; the markers are {list(names)}.")
+        return names.index(marker)
+
+    def _plans(self, X, clips):
+        """Per clip: (skeleton, MarkerSet or None, frame rate); and the marker names."""
+        sources = self._clip_sources(X, len(clips))
+        resolved = {}
+        plans, names = [], None
+        for i, (skeleton, frame_rate) in enumerate(sources):
+            if skeleton is None:
+                markers, clip_names = None, self._input_marker_names(clips.n_channels)
+            else:
+                if skeleton.n_channels != clips.n_channels:
+                    raise ValueError(
+                        f"X: clip {i} has {clips.n_channels} channels, but its skeleton has {skeleton.n_channels}."
+                    )
+                if skeleton not in resolved:
+                    markers = self._marker_set(skeleton)
+                    markers.joint_indices(skeleton)  # every marker's joint exists
+                    resolved[skeleton] = markers
+                markers = resolved[skeleton]
+                clip_names = markers.names
+            if names is None:
+                names = clip_names
+            elif clip_names != names:
+                raise ValueError(f"X: clip {i} gets markers {list(clip_names)[:5]}..., other clips {list(names)[:5]}...")
+            plans.append((skeleton, markers, frame_rate))
+        return plans, names
+
+    def _indices(self, names):
+        root = self._index(names, self.root_marker, "root_marker")
+        if len(self.facing_markers) != 2:
+            raise ValueError(f"facing_markers must be a (left, right) pair, got {self.facing_markers!r}.")
+        left, right = (self._index(names, m, "facing marker") for m in self.facing_markers)
+        if self.size_markers is None:
+            chain = None
+        else:
+            wanted = SIZE_CHAIN if isinstance(self.size_markers, str) else self.size_markers
+            chain = [self._index(names, m, "size marker") for m in wanted]
+            if len(chain) < 2:
+                raise ValueError("size_markers needs at least two markers.")
+        return root, left, right, chain
+
+    # -- the estimator API ------------------------------------------------------------------
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y=None):
+        """Check the clips and resolve the marker set(s).
+
+        Parameters
+        ----------
+        X : list of Motion or of ndarray of shape (n_frames_i, n_channels), ndarray or DataFrame
+            Joint-angle clips (Motions, or arrays of ``skeleton``), or marker
+            positions when ``skeleton=None``; at least two frames per clip.
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        self : VirtualMarkerTransform
+            The fitted transformer.
+        """
+        clips = check_clips(X, estimator=self, reset=True, min_frames=2)
+        _, names = self._plans(X, clips)
+        self._indices(names)
+        self.marker_names_ = np.asarray(names, dtype=object)
+        self.n_markers_ = len(names)
+        return self
+
+    def transform(self, X):
+        """Virtual-marker positions and velocities of every clip.
+
+        Parameters
+        ----------
+        X : list of Motion or of ndarray of shape (n_frames_i, n_channels), ndarray or DataFrame
+            Clips like those seen in fit.
+
+        Returns
+        -------
+        X_new : list of ndarray of shape (n_frames_i, 6 * n_markers_)
+            In the container kind of ``X`` (a DataFrame after
+            ``set_output(transform="pandas")``).
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self, min_frames=2)
+        plans, names = self._plans(X, clips)
+        if list(names) != list(self.marker_names_):
+            raise ValueError("X: the clips' markers differ from those seen in fit.")
+        root, left, right, chain = self._indices(names)
+
+        def one(i):
+            skeleton, markers, frame_rate = plans[i]
+            clip = clips[i]
+            if markers is None:
+                positions = clip.reshape(len(clip), -1, 3).astype(float)
+                up = self.up_axis or "y"
+            else:
+                positions = markers.positions(skeleton, clip)
+                up = self.up_axis or skeleton.up_axis
+            size = 1.0 if chain is None else body_size(positions, chain)
+            if not size > 0:
+                raise ValueError(f"X: clip {i} has size 0 along size_markers; check the markers.")
+            try:
+                return body_frame_features(
+                    positions, frame_rate=frame_rate, root=root, left=left, right=right,
+                    up_axis=up, floor=self.floor, size=size,
+                )
+            except ValueError as exc:
+                raise ValueError(f"X: clip {i}: {exc}") from None
+
+        out = parallel_map(one, range(len(clips)), n_jobs=self.n_jobs)
+        return self._wrap_clips(out, clips)
+
+    def get_feature_names_out(self, input_features=None):
+        """Output channel names, ``"<marker>_<px|py|pz|vx|vy|vz>"``.
+
+        Parameters
+        ----------
+        input_features : array-like of str, default=None
+            Ignored (the output names come from the markers).
+
+        Returns
+        -------
+        feature_names_out : ndarray of str
+        """
+        check_is_fitted(self)
+        return np.asarray([f"{m}_{c}" for m in self.marker_names_ for c in _COMPONENTS], dtype=object)
+
+
+def to_markers(motions, transformer=None):
+    """Virtual-marker clips of motions from any mix of skeletons, in input order.
+
+    One :class:`VirtualMarkerTransform` call takes clips that share their
+    channels. Motions of different skeleton families (a CMU ASF subject and
+    a Character Creator BVH, say) have different channels, but the same
+    marker names: this groups the motions by channel layout, fits a clone of
+    ``transformer`` on each group and returns every clip's markers, which all
+    share one feature space.
+
+    Parameters
+    ----------
+    motions : list of Motion
+        The motions, each with its own skeleton and frame rate.
+    transformer : VirtualMarkerTransform, default=None
+        Its parameters are used for every group (default: all defaults).
+
+    Returns
+    -------
+    clips : list of ndarray of shape (n_frames_i, 6 * n_markers)
+        One per motion, in input order.
+    names : ndarray of str
+        The output channel names, shared by every clip.
+
+    Examples
+    --------
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.io import Motion, as_motions
+    >>> from skmotion.kinematics import Skeleton
+    >>> from skmotion.preprocessing import VirtualMarkerTransform, to_markers
+    >>> data = make_motions(n_clips_per_class=1, classes=["walk", "wave"], random_state=0)
+    >>> motions = as_motions(data.clips, data.skeletons, data.frame_rate)
+    >>> # A second skeleton family: the humanoid without toes has 6 channels fewer.
+    >>> sk = motions[1].skeleton
+    >>> keep = [j for j, name in enumerate(sk.joints) if "Toe" not in name]
+    >>> bare = Skeleton([sk.joints[j] for j in keep], [keep.index(sk.parents[j]) if j else -1 for j in keep],
+    ...                 sk.offsets[keep], [sk.channels[j] for j in keep], up_axis="y")
+    >>> columns = [c for c, name in enumerate(sk.channel_names) if "Toe" not in name]
+    >>> motions[1] = Motion(bare, motions[1].channels[:, columns], frame_rate=30.0)
+    >>> motions[0].n_channels, motions[1].n_channels
+    (66, 60)
+    >>> clips, names = to_markers(motions, VirtualMarkerTransform(markers=[
+    ...     ("pelvis", "Hips", (0, 0, 0)), ("left_hip", "LeftUpLeg", (0, 0, 0)),
+    ...     ("right_hip", "RightUpLeg", (0, 0, 0)), ("head", "Head", (0, 0, 0))], size_markers=None))
+    >>> [c.shape[1] for c in clips], names[0]
+    ([24, 24], 'pelvis_px')
+    """
+    transformer = VirtualMarkerTransform() if transformer is None else transformer
+    motions = list(motions)
+    bad = [i for i, m in enumerate(motions) if not isinstance(m, Motion)]
+    if bad:
+        raise TypeError(f"motions: item {bad[0]} is a {type(motions[bad[0]]).__name__}, not a Motion.")
+    groups = {}
+    for i, motion in enumerate(motions):
+        groups.setdefault(tuple(motion.channel_names), []).append(i)
+    clips, names = [None] * len(motions), None
+    for rows in groups.values():
+        fitted = clone(transformer).fit([motions[i] for i in rows])
+        group_names = fitted.get_feature_names_out()
+        if names is not None and list(group_names) != list(names):
+            raise ValueError("motions: the skeletons' marker sets have different marker names.")
+        names = group_names
+        for i, clip in zip(rows, fitted.transform([motions[i] for i in rows])):
+            clips[i] = clip
+    return clips, names
