@@ -14,6 +14,9 @@ _SUBPACKAGES = (
     "decomposition",
     "io",
     "kinematics",
+    "metrics",
+    "neighbors",
+    "plotting",
     "preprocessing",
     "utils",
 )

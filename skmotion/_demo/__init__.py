@@ -13,6 +13,7 @@ __all__ = ["SECTIONS", "run_demo"]
 SECTIONS = (
     "skmotion._demo.data",
     "skmotion._demo.markers",
+    "skmotion._demo.index",
     "skmotion._demo.primitives",
 )
 

@@ -9,6 +9,7 @@ from skmotion.datasets._motion_files import (
     load_motion_folder,
     read_cmu_index,
 )
+from skmotion.datasets._repeats import make_repeated_motions
 from skmotion.datasets._synthetic import MOTION_CLASSES, make_motions
 from skmotion.datasets._uea import load_uea
 
@@ -22,5 +23,6 @@ __all__ = [
     "load_motion_folder",
     "load_uea",
     "make_motions",
+    "make_repeated_motions",
     "read_cmu_index",
 ]

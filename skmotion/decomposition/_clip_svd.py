@@ -1,0 +1,107 @@
+"""Right singular vectors and singular values of every clip, computed in batches.
+
+Both the SVD feature vectors and the similarity psi need, for each clip ``A``
+(``n_frames x n_channels``), the singular values and the leading right singular
+vectors. For the usual clip (more frames than channels) they come from the
+``n_channels x n_channels`` Gram matrix ``A^T A``, whose eigen-decomposition is
+batched over clips; a clip with fewer frames than channels takes a thin SVD,
+which is cheaper there. Nothing loops over frames.
+"""
+
+import numpy as np
+
+# threadpoolctl comes with scikit-learn (one of its own dependencies).
+from threadpoolctl import ThreadpoolController
+
+from skmotion.utils._parallel import parallel_map
+
+__all__ = ["clip_spectra", "small_blas"]
+
+
+def small_blas():
+    """Context in which BLAS/LAPACK run on one thread.
+
+    Per-clip problems are small (tens of channels): a multithreaded BLAS spends
+    far longer synchronising its threads than computing, and on a busy machine
+    it slows them a hundredfold. Parallelism comes from ``n_jobs`` instead.
+    """
+    global _CONTROLLER
+    if _CONTROLLER is None:  # finding the loaded BLAS libraries is slow: do it once
+        _CONTROLLER = ThreadpoolController()
+    return _CONTROLLER.limit(limits=1, user_api="blas")
+
+
+_CONTROLLER = None
+
+# Clips per task: fixed, so the tasks (and so the results) do not depend on n_jobs.
+_CHUNK = 512
+
+
+def _rank_tolerance(eigenvalues):
+    """Eigenvalues of a Gram matrix below this are rounding noise, i.e. zero."""
+    n = eigenvalues.shape[-1]
+    return eigenvalues.max(axis=-1, keepdims=True) * n * 10 * np.finfo(np.float64).eps
+
+
+def _spectra_of_chunk(chunk, n_vectors):
+    n = chunk[0].shape[1]
+    n_clips = len(chunk)
+    eigenvalues = np.zeros((n_clips, n))
+    vectors = np.zeros((n_clips, n, n_vectors))
+    tall = [i for i, c in enumerate(chunk) if len(c) >= n]
+    if tall:
+        gram = np.stack([chunk[i].T @ chunk[i] for i in tall]).astype(np.float64, copy=False)
+        values, vecs = np.linalg.eigh(gram)  # ascending
+        eigenvalues[tall] = values[:, ::-1]
+        vectors[tall] = vecs[:, :, ::-1][:, :, :n_vectors]
+    for i in (i for i, c in enumerate(chunk) if len(c) < n):
+        _, s, vt = np.linalg.svd(np.asarray(chunk[i], dtype=np.float64), full_matrices=False)
+        eigenvalues[i, : len(s)] = s**2
+        m = min(len(s), n_vectors)
+        vectors[i, :, :m] = vt[:m].T
+    eigenvalues = np.clip(eigenvalues, 0.0, None)
+    # Directions beyond a clip's rank are undefined: make them zero vectors, so
+    # that every caller treats them the same whichever route computed them.
+    null = eigenvalues <= _rank_tolerance(eigenvalues)
+    eigenvalues[null] = 0.0
+    vectors[null[:, :n_vectors][:, None, :].repeat(n, axis=1)] = 0.0
+    return eigenvalues, vectors
+
+
+def clip_spectra(clips, n_vectors, *, n_jobs=None):
+    """Squared singular values and leading right singular vectors of each clip.
+
+    Parameters
+    ----------
+    clips : list of ndarray of shape (n_frames_i, n_channels)
+        Validated clips (see :func:`skmotion.utils.check_clips`).
+    n_vectors : int
+        How many leading right singular vectors to return (at most ``n_channels``).
+    n_jobs : int, default=None
+        Number of jobs over chunks of clips; results do not depend on it.
+
+    Returns
+    -------
+    eigenvalues : ndarray of shape (n_clips, n_channels)
+        Eigenvalues of each ``A^T A`` (the squared singular values of ``A``),
+        in decreasing order; zero beyond the clip's rank.
+    vectors : ndarray of shape (n_clips, n_channels, n_vectors)
+        ``vectors[c, :, i]`` is the ``i``-th right singular vector of clip ``c``
+        (unit norm, arbitrary sign), or zeros when ``i`` is at or beyond its rank.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.decomposition._clip_svd import clip_spectra
+    >>> A = np.array([[3.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
+    >>> values, vectors = clip_spectra([A], n_vectors=2)
+    >>> values.tolist()
+    [[9.0, 1.0]]
+    >>> np.abs(vectors[0]).tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
+    n_vectors = min(int(n_vectors), clips[0].shape[1])
+    chunks = [clips[i : i + _CHUNK] for i in range(0, len(clips), _CHUNK)]
+    with small_blas():
+        parts = parallel_map(lambda chunk: _spectra_of_chunk(chunk, n_vectors), chunks, n_jobs=n_jobs)
+    return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])

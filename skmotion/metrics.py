@@ -1,0 +1,279 @@
+"""Metrics of similarity search and scorers for ``GridSearchCV``.
+
+"Similar" means "has the same label". For a query, the stored clips with its label
+are relevant and the others irrelevant; an index returns a candidate set.
+"""
+
+from numbers import Real
+
+import numpy as np
+
+from skmotion.utils._sklearn_compat import Interval, validate_params
+
+__all__ = [
+    "make_pruning_scorer",
+    "pruning_efficiency",
+    "pruning_scorer",
+    "recall",
+    "recall_scorer",
+]
+
+
+def _per_query_counts(candidates, y_query, y_stored, query_ids):
+    """Per query: relevant returned, relevant stored, irrelevant returned, irrelevant stored."""
+    y_query = np.asarray(y_query)
+    y_stored = np.asarray(y_stored)
+    if len(candidates) != len(y_query):
+        raise ValueError(f"candidates holds {len(candidates)} sets, but y_query has {len(y_query)} labels.")
+    if query_ids is not None and len(query_ids) != len(y_query):
+        raise ValueError(f"query_ids has {len(query_ids)} ids, but y_query has {len(y_query)} labels.")
+    labels, stored_codes = np.unique(y_stored, return_inverse=True)
+    per_label = np.bincount(stored_codes, minlength=len(labels))
+    counts = np.zeros((len(y_query), 4), dtype=np.int64)
+    for q, (found, label) in enumerate(zip(candidates, y_query)):
+        found = np.asarray(found, dtype=np.intp)
+        if query_ids is not None:
+            found = found[found != query_ids[q]]
+        at = np.searchsorted(labels, label)
+        stored_relevant = per_label[at] if at < len(labels) and labels[at] == label else 0
+        n_stored = len(y_stored)
+        if query_ids is not None:  # the query itself is neither relevant nor irrelevant
+            stored_relevant -= 1
+            n_stored -= 1
+        returned_relevant = int(np.count_nonzero(y_stored[found] == label))
+        counts[q] = (
+            returned_relevant,
+            stored_relevant,
+            len(found) - returned_relevant,
+            n_stored - stored_relevant,
+        )
+    return counts
+
+
+_METRIC_PARAMS = {
+    "candidates": [list, tuple],
+    "y_query": ["array-like"],
+    "y_stored": ["array-like"],
+    "query_ids": ["array-like", None],
+}
+
+
+@validate_params(_METRIC_PARAMS, prefer_skip_nested_validation=True)
+def pruning_efficiency(candidates, y_query, y_stored, *, query_ids=None):
+    """Share of the irrelevant stored clips that the index pruned, averaged over queries.
+
+    For one query, ``P = N_pr / N_ir``: irrelevant clips (another label) left
+    out of its candidates over all irrelevant stored clips (Li & Prabhakaran).
+    Queries with no irrelevant clip stored are left out of the mean.
+
+    Parameters
+    ----------
+    candidates : list of array-like of int
+        For each query, ids (positions in ``y_stored``) of its candidates.
+    y_query : array-like of shape (n_queries,)
+        Label of each query.
+    y_stored : array-like of shape (n_stored,)
+        Label of each stored clip.
+    query_ids : array-like of shape (n_queries,), default=None
+        When the queries are stored clips themselves, their ids: each query is
+        then left out of its own counts (as in a leave-one-out evaluation).
+
+    Returns
+    -------
+    efficiency : float
+        In ``[0, 1]``; NaN when no query has an irrelevant clip.
+
+    See Also
+    --------
+    recall : the share of similar clips kept.
+
+    Examples
+    --------
+    >>> from skmotion.metrics import pruning_efficiency
+    >>> y_stored = ["walk", "walk", "jump", "jump", "kick"]
+    >>> # the query is a walk; the candidates keep both walks and one jump
+    >>> pruning_efficiency([[0, 1, 2]], ["walk"], y_stored)
+    0.666...
+    """
+    counts = _per_query_counts(candidates, y_query, y_stored, query_ids)
+    defined = counts[:, 3] > 0
+    if not defined.any():
+        return float("nan")
+    pruned = counts[defined, 3] - counts[defined, 2]
+    return float(np.mean(pruned / counts[defined, 3]))
+
+
+@validate_params(_METRIC_PARAMS, prefer_skip_nested_validation=True)
+def recall(candidates, y_query, y_stored, *, query_ids=None):
+    """Share of the similar stored clips that the candidates keep, averaged over queries.
+
+    Similar means the same label. Queries with no similar clip stored are left
+    out of the mean.
+
+    Parameters
+    ----------
+    candidates : list of array-like of int
+        For each query, ids (positions in ``y_stored``) of its candidates.
+    y_query : array-like of shape (n_queries,)
+        Label of each query.
+    y_stored : array-like of shape (n_stored,)
+        Label of each stored clip.
+    query_ids : array-like of shape (n_queries,), default=None
+        When the queries are stored clips themselves, their ids (left out of
+        their own counts).
+
+    Returns
+    -------
+    recall : float
+        In ``[0, 1]``; NaN when no query has a similar clip stored.
+
+    See Also
+    --------
+    pruning_efficiency : the share of irrelevant clips pruned.
+
+    Examples
+    --------
+    >>> from skmotion.metrics import recall
+    >>> y_stored = ["walk", "walk", "jump", "jump", "kick"]
+    >>> recall([[0, 2], [2, 3, 4]], ["walk", "jump"], y_stored)
+    0.75
+    >>> recall([[1], [0]], ["walk", "walk"], y_stored, query_ids=[0, 1])
+    1.0
+    """
+    counts = _per_query_counts(candidates, y_query, y_stored, query_ids)
+    defined = counts[:, 1] > 0
+    if not defined.any():
+        return float("nan")
+    return float(np.mean(counts[defined, 0] / counts[defined, 1]))
+
+
+def _index_and_queries(estimator, X):
+    """The index at the end of ``estimator`` (maybe a Pipeline) and X as it sees it."""
+    steps = getattr(estimator, "steps", None)
+    if steps is None:
+        return estimator, X
+    for _, step in steps[:-1]:
+        if step is not None and step != "passthrough":
+            X = step.transform(X)
+    return steps[-1][1], X
+
+
+def _search_quality(estimator, X, y):
+    index, X = _index_and_queries(estimator, X)
+    candidates = index.candidates(X)
+    return (
+        pruning_efficiency(candidates, y, index.labels_),
+        recall(candidates, y, index.labels_),
+    )
+
+
+def pruning_scorer(estimator, X, y):
+    """Scorer: the pruning efficiency of the fitted index on held-out queries.
+
+    For ``GridSearchCV(scoring=...)``: the validation clips query the index
+    built on the training clips. ``estimator`` is an
+    :class:`~skmotion.neighbors.IntervalIndexNeighbors` or a Pipeline ending in one.
+
+    Parameters
+    ----------
+    estimator : fitted IntervalIndexNeighbors or Pipeline
+    X : clips or feature vectors
+        Queries.
+    y : array-like of shape (n_queries,)
+        Their labels.
+
+    Returns
+    -------
+    score : float
+
+    Examples
+    --------
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.metrics import pruning_scorer
+    >>> from skmotion.neighbors import IntervalIndexNeighbors
+    >>> data = make_motions(n_clips_per_class=6, random_state=0)
+    >>> clips = [c[:, 6:] for c in data.clips]
+    >>> index = IntervalIndexNeighbors(n_levels=5).fit(clips[::2], data.target[::2])
+    >>> 0 <= pruning_scorer(index, clips[1::2], data.target[1::2]) <= 1
+    True
+    """
+    return _search_quality(estimator, X, y)[0]
+
+
+def recall_scorer(estimator, X, y):
+    """Scorer: the recall of the fitted index on held-out queries.
+
+    Parameters
+    ----------
+    estimator : fitted IntervalIndexNeighbors or Pipeline
+    X : clips or feature vectors
+        Queries.
+    y : array-like of shape (n_queries,)
+        Their labels.
+
+    Returns
+    -------
+    score : float
+
+    Examples
+    --------
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.metrics import recall_scorer
+    >>> from skmotion.neighbors import IntervalIndexNeighbors
+    >>> data = make_motions(n_clips_per_class=6, random_state=0)
+    >>> clips = [c[:, 6:] for c in data.clips]
+    >>> index = IntervalIndexNeighbors(n_levels=5).fit(clips[::2], data.target[::2])
+    >>> 0 <= recall_scorer(index, clips[1::2], data.target[1::2]) <= 1
+    True
+    """
+    return _search_quality(estimator, X, y)[1]
+
+
+class _PruningAtRecall:
+    """Pruning efficiency while recall >= min_recall, else recall - 1 (negative)."""
+
+    def __init__(self, min_recall):
+        self.min_recall = min_recall
+
+    def __call__(self, estimator, X, y):
+        pruning, found = _search_quality(estimator, X, y)
+        return pruning if found >= self.min_recall else found - 1.0
+
+    def __repr__(self):
+        return f"make_pruning_scorer(min_recall={self.min_recall!r})"
+
+
+@validate_params({"min_recall": [Interval(Real, 0, 1, closed="both")]}, prefer_skip_nested_validation=True)
+def make_pruning_scorer(min_recall=0.99):
+    """A scorer that rewards pruning only while recall stays at or above a bound.
+
+    The score is the pruning efficiency when recall ``>= min_recall``, else
+    ``recall - 1`` (negative). Any setting that keeps the recall beats every
+    setting that does not, and among those that do not, the higher recall wins.
+
+    Parameters
+    ----------
+    min_recall : float, default=0.99
+        The recall a setting must keep.
+
+    Returns
+    -------
+    scorer : callable
+        ``scorer(estimator, X, y) -> float``, for ``GridSearchCV(scoring=...)``.
+
+    Examples
+    --------
+    >>> from sklearn.model_selection import GridSearchCV
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.metrics import make_pruning_scorer
+    >>> from skmotion.neighbors import IntervalIndexNeighbors
+    >>> data = make_motions(n_clips_per_class=6, random_state=0)
+    >>> clips = [c[:, 6:] for c in data.clips]
+    >>> search = GridSearchCV(
+    ...     IntervalIndexNeighbors(n_levels=4), {"epsilon": [0.6, 1.2]},
+    ...     scoring=make_pruning_scorer(0.9), cv=3,
+    ... ).fit(clips, data.target)
+    >>> sorted(search.best_params_)
+    ['epsilon']
+    """
+    return _PruningAtRecall(min_recall)

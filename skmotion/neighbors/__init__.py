@@ -1,0 +1,7 @@
+"""Neighbors: the similarity psi and the interval index for fast similarity search."""
+
+from skmotion.neighbors._interval_index import IntervalIndex
+from skmotion.neighbors._interval_neighbors import IntervalIndexNeighbors
+from skmotion.neighbors._psi import pairwise_psi, psi
+
+__all__ = ["IntervalIndex", "IntervalIndexNeighbors", "pairwise_psi", "psi"]

@@ -1,0 +1,136 @@
+"""The interval index against hand-worked trees and a brute-force reference."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
+
+
+def brute_force_candidates(edges, radius, items, query):
+    """All items whose covering interval overlaps the query's entry at every level.
+
+    Written from the definition with explicit loops: entry ``j`` of a level is the
+    closed interval ``[b_j, b_{j+1}]`` with ``b_0 = -inf`` and ``b_n = +inf``; the
+    query's entry is the one with ``b_j <= c < b_{j+1}``.
+    """
+    out = []
+    for item_id, item in enumerate(items):
+        keep = True
+        for level, inner in enumerate(edges):
+            bounds = [-np.inf, *inner.tolist(), np.inf]
+            c = query[level]
+            j = next(j for j in range(len(bounds) - 1) if bounds[j] <= c < bounds[j + 1])
+            lo, hi = item[level] - radius[level], item[level] + radius[level]
+            if not (bounds[j] <= hi and bounds[j + 1] >= lo):
+                keep = False
+                break
+        if keep:
+            out.append(item_id)
+    return out
+
+
+def test_hand_worked_two_levels():
+    # Level 0: entries (-inf,0.25] [0.25,0.5] [0.5,0.75] [0.75,inf), radius 0.1.
+    # Level 1: entries (-inf,0] [0,inf), radius 0.05.
+    index = IntervalIndex([np.array([0.25, 0.5, 0.75]), np.array([0.0])], radius=[0.1, 0.05])
+    items = np.array(
+        [
+            [0.30, 0.50],  # level 0 entries 0-1, level 1 entry 1
+            [0.45, 0.02],  # level 0 entries 1-2, level 1 entries 0-1
+            [0.90, -0.5],  # level 0 entry 3, level 1 entry 0
+            [0.62, -0.04],  # level 0 entry 2, level 1 entries 0-1
+        ]
+    )
+    index.insert(items)
+    queries = {
+        (0.1, 0.3): [0],
+        (0.3, -0.3): [1],
+        (0.3, 0.3): [0, 1],
+        (0.55, 0.1): [1, 3],
+        (0.55, -0.1): [1, 3],
+        (0.8, -0.1): [2],
+        (0.8, 0.1): [],
+        (0.5, 0.0): [1, 3],  # on a boundary: the entry above
+    }
+    for query, expected in queries.items():
+        assert index.candidates(np.array([query]))[0].tolist() == expected, query
+    # Leaves: item 0 in 2 (0,1),(1,1); item 1 in 4; item 2 in 1; item 3 in 2.
+    assert index.n_stored() == 2 + 4 + 1 + 2
+    assert index.n_nodes == [1, 4, 6]
+
+
+def test_entry_edges_follow_width_and_cap():
+    np.testing.assert_allclose(entry_edges(-1.0, 1.0, 0.5, 100), [-0.5, 0.0, 0.5])
+    # ceil(2 / 0.3) = 7 entries of width 0.3, the last one ending past 1.0.
+    np.testing.assert_allclose(entry_edges(-1.0, 1.0, 0.3, 100), -1.0 + 0.3 * np.arange(1, 7))
+    np.testing.assert_allclose(entry_edges(0.0, 1.0, 0.0, 5), [0.2, 0.4, 0.6, 0.8])
+    assert entry_edges(0.3, 0.3, 0.1, 5).size == 0
+
+
+def test_rejects_bad_structure():
+    with pytest.raises(ValueError, match="strictly increasing"):
+        IntervalIndex([np.array([0.5, 0.2])], radius=[0.1])
+    with pytest.raises(ValueError, match="one non-negative value per level"):
+        IntervalIndex([np.array([0.5])], radius=[0.1, 0.2])
+    index = IntervalIndex([np.array([0.5]), np.array([0.5])], radius=[0.1, 0.1])
+    with pytest.raises(ValueError, match="at least 2 components"):
+        index.insert(np.zeros((3, 1)))
+
+
+# Values on a coarse grid so that components often fall exactly on entry
+# boundaries and covering intervals often just touch them.
+grid = st.integers(-8, 8).map(lambda v: v / 8)
+
+
+@st.composite
+def index_case(draw):
+    n_levels = draw(st.integers(1, 4))
+    edges = [np.array(sorted(draw(st.sets(grid, max_size=5)))) for _ in range(n_levels)]
+    radius = np.array([draw(st.sampled_from([0.0, 0.125, 0.25, 0.3, 0.6])) for _ in range(n_levels)])
+    vector = st.lists(grid | st.floats(-1.5, 1.5), min_size=n_levels, max_size=n_levels)
+    items = np.array(draw(st.lists(vector, min_size=1, max_size=25)), dtype=float)
+    queries = np.array(draw(st.lists(vector, min_size=1, max_size=10)), dtype=float)
+    split = draw(st.integers(0, len(items)))
+    return edges, radius, items, queries, split
+
+
+@given(index_case())
+def test_candidates_equal_brute_force(case):
+    edges, radius, items, queries, split = case
+    index = IntervalIndex(edges, radius)
+    # Two insertions (the second into a non-empty tree) must act as one.
+    index.insert(items[:split])
+    index.insert(items[split:])
+    assert index.n_items == len(items)
+    for query, found in zip(queries, index.candidates(queries)):
+        assert found.tolist() == brute_force_candidates(edges, radius, items, query)
+    # Every item is found by a query equal to itself.
+    for item_id, found in enumerate(index.candidates(items)):
+        assert item_id in found
+
+
+@given(index_case())
+def test_leaves_hold_each_item_in_prod_of_spans(case):
+    edges, radius, items, _, _ = case
+    index = IntervalIndex(edges, radius)
+    index.insert(items)
+    first, last = index.covering_entries(items)
+    assert index.n_stored() == int(np.prod(last - first + 1, axis=1).sum())
+
+
+def test_large_insertions_are_split_and_agree(monkeypatch):
+    from skmotion.neighbors import _interval_index as module
+
+    rng = np.random.default_rng(0)
+    edges = [np.linspace(-1, 1, 9)[1:-1]] * 3
+    items, queries = rng.uniform(-1, 1, (300, 3)), rng.uniform(-1, 1, (50, 3))
+    whole = IntervalIndex(edges, [0.3] * 3)
+    whole.insert(items)
+    monkeypatch.setattr(module, "_PAIRS_PER_STEP", 64)
+    pieces = IntervalIndex(edges, [0.3] * 3)
+    pieces.insert(items)
+    for a, b in zip(whole.candidates(queries), pieces.candidates(queries)):
+        np.testing.assert_array_equal(a, b)
+    assert whole.n_nodes == pieces.n_nodes
