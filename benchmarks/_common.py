@@ -30,6 +30,19 @@ def time_call(func, *, repeats=5, warmup=1):
     return statistics.median(times), (statistics.stdev(times) if repeats > 1 else 0.0)
 
 
+def interleaved(funcs, rounds):
+    """Median seconds of each function, timed in alternation so that they share the machine's load."""
+    for func in funcs:
+        func()  # warm-up
+    times = [[] for _ in funcs]
+    for _ in range(rounds):
+        for func, bucket in zip(funcs, times):
+            start = time.perf_counter()
+            func()
+            bucket.append(time.perf_counter() - start)
+    return [statistics.median(bucket) for bucket in times]
+
+
 def write_results(name, rows, *, notes=""):
     """Write ``rows`` (a list of dicts) as ``results/<name>.csv`` and ``.md``; print the table."""
     RESULTS.mkdir(exist_ok=True)

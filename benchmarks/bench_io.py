@@ -8,15 +8,13 @@ line-by-line parser (a dict of bone values per frame, as the common Python AMC
 readers do). Run: ``python benchmarks/bench_io.py`` (needs ``pip install -e ".[bench]"``).
 """
 
-import statistics
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA, write_results  # noqa: E402
+from _common import SHARED_DATA, interleaved, write_results  # noqa: E402
 
 from skmotion.io import read_amc, read_asf, read_bvh  # noqa: E402
 
@@ -48,19 +46,6 @@ def line_by_line_amc(path):
             else:
                 frames[-1][words[0]] = [float(w) for w in words[1:]]
     return frames
-
-
-def interleaved(funcs, rounds):
-    """Median seconds of each function, timed in alternation so that they share the machine's load."""
-    for func in funcs:
-        func()  # warm-up
-    times = [[] for _ in funcs]
-    for _ in range(rounds):
-        for func, bucket in zip(funcs, times):
-            start = time.perf_counter()
-            func()
-            bucket.append(time.perf_counter() - start)
-    return [statistics.median(bucket) for bucket in times]
 
 
 def bench_bvh(files, repeats):

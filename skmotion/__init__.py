@@ -9,6 +9,7 @@ __version__ = "0.1.0"
 
 _SUBPACKAGES = (
     "base",
+    "control",
     "datasets",
     "decomposition",
     "io",

@@ -11,7 +11,7 @@ from skmotion.utils._clips import to_container
 
 __all__ = ["ClipEstimatorMixin", "ClipFeatureMixin", "ClipTransformerMixin", "MotionTags"]
 
-OUTPUT_KINDS = frozenset({"clips", "table", "labels", "scores"})
+OUTPUT_KINDS = frozenset({"clips", "table", "labels", "scores", "segments"})
 
 
 @dataclass(frozen=True)
@@ -22,9 +22,10 @@ class MotionTags:
     ----------
     variable_length : bool, default=True
         Clips of one collection may have different numbers of frames.
-    output_kind : {"clips", "table", "labels", "scores"}, default="labels"
+    output_kind : {"clips", "table", "labels", "scores", "segments"}, default="labels"
         What ``transform``/``predict`` returns: clips (clip-to-clip transformer),
-        a table ``(n_clips, n_features)``, one label per clip, or scores.
+        a table ``(n_clips, n_features)``, one label per clip, scores, or per
+        clip a list of segment rows (``(n_segments_i, n_features)`` arrays).
     requires_skeleton : bool, default=False
         Whether the estimator needs a ``Skeleton`` to interpret its input.
     min_frames : int, default=1

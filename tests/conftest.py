@@ -57,3 +57,18 @@ def shared_data():
     if not SHARED_DATA.is_dir():
         pytest.skip(f"real motion data not found at {SHARED_DATA} (set SKMOTION_SHARED_DATA)")
     return SHARED_DATA
+
+
+@pytest.fixture(scope="session")
+def demo_report():
+    """The output of ``skmotion demo``, run once for every test that reads it."""
+    import contextlib
+    import io
+
+    from skmotion.cli import main
+
+    buffer = io.StringIO()
+    with contextlib.redirect_stdout(buffer):
+        status = main(["demo"])
+    assert status == 0
+    return buffer.getvalue()

@@ -4,12 +4,12 @@ import sys
 import pytest
 
 from skmotion import __version__
+from skmotion._demo import run_demo
 from skmotion.cli import main
 
 
-def test_demo_reports_the_data(capsys):
-    assert main(["demo"]) == 0
-    out = capsys.readouterr().out
+def test_demo_reports_the_data(demo_report):
+    out = demo_report
     assert "== Data: built-in synthetic motions ==" in out
     assert "84 clips" in out
     assert "classes (7): walk 12, jog 12, jump 12, kick 12, wave 12, punch 12, squat 12" in out
@@ -18,12 +18,13 @@ def test_demo_reports_the_data(capsys):
     assert 0.3 < accuracy < 0.95
 
 
-def test_demo_seed_changes_the_data(capsys):
-    main(["demo", "--random-state", "1"])
-    first = capsys.readouterr().out
-    main(["demo", "--random-state", "2"])
-    second = capsys.readouterr().out
-    assert first.split("frames")[0] != second.split("frames")[0]
+def test_demo_seed_changes_the_data():
+    reports = []
+    for seed in (1, 2):
+        lines = []
+        run_demo(lines.append, random_state=seed, sections=("skmotion._demo.data",))
+        reports.append("\n".join(lines))
+    assert reports[0].split("frames")[0] != reports[1].split("frames")[0]
 
 
 def test_version_and_help(capsys):

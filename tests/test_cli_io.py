@@ -43,9 +43,8 @@ def test_info_asf_and_amc(tmp_path, rng, capsys):
     assert "bad.bvh" in capsys.readouterr().err
 
 
-def test_demo_has_the_marker_section(capsys):
-    assert main(["demo"]) == 0
-    out = capsys.readouterr().out
+def test_demo_has_the_marker_section(demo_report):
+    out = demo_report
     assert "== Virtual markers: positions and velocities in the body frame ==" in out
     assert "32 markers" in out and "humanoid 84 clips" in out and "192 channels per frame" in out
     accuracy = float(out.split("accuracy ")[2].split()[0])

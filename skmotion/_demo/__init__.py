@@ -10,7 +10,12 @@ from types import SimpleNamespace
 
 __all__ = ["SECTIONS", "run_demo"]
 
-SECTIONS = ("skmotion._demo.data", "skmotion._demo.markers", "skmotion._demo.index")
+SECTIONS = (
+    "skmotion._demo.data",
+    "skmotion._demo.markers",
+    "skmotion._demo.index",
+    "skmotion._demo.primitives",
+)
 
 
 def run_demo(write, *, random_state=0, sections=SECTIONS, **options):

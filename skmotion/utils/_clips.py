@@ -231,7 +231,8 @@ def check_clips(
     allow_nan : bool, default=False
         Whether NaN (a missing value) is allowed. Infinity never is.
     min_frames : int, default=1
-        The fewest frames a clip may have.
+        The fewest frames a clip may have. ``0`` accepts empty clips of shape
+        ``(0, n_channels)`` (sequences of segment codes of clips without segments).
     min_clips : int, default=1
         The fewest clips the collection may have.
     dtype : dtype or tuple of dtypes, default=(np.float64, np.float32)
@@ -318,7 +319,7 @@ def check_clips(
                 "expected a 2-D array of shape (n_frames, n_channels)"
                 + (" (use clip.reshape(-1, 1) for one channel)." if arr.ndim == 1 else ".")
             )
-        if arr.shape[0] == 0:
+        if arr.shape[0] == 0 and min_frames > 0:
             raise ValueError(f"{input_name}: clip {i} has no frames.")
         if arr.shape[1] == 0:
             raise ValueError(f"{input_name}: clip {i} has no channels.")

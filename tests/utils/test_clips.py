@@ -275,3 +275,12 @@ def test_dataframe_round_trip_property(clip_list):
     checked = check_clips(df)
     for a, b in zip(checked, clip_list):
         np.testing.assert_array_equal(a, b)
+
+
+def test_empty_clips_only_when_min_frames_is_zero():
+    # Sequences of segment codes: a clip without segments is a (0, k) array.
+    codes = [np.zeros((0, 3)), np.ones((2, 3))]
+    clips = check_clips(codes, min_frames=0)
+    assert clips.lengths.tolist() == [0, 2] and clips.n_channels == 3
+    with pytest.raises(ValueError, match="clip 0 has no frames"):
+        check_clips(codes)

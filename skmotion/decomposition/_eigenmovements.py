@@ -1,0 +1,442 @@
+"""EigenMovementPCA: PCA of segmented movement (eigenmovements)."""
+
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import BaseEstimator, TransformerMixin
+from sklearn.utils.validation import check_is_fitted
+
+from skmotion.base import ClipEstimatorMixin, MotionTags
+from skmotion.decomposition._principal_axes import principal_axes
+from skmotion.decomposition._segment_vectors import (
+    assemble_segments,
+    check_segments,
+    frame_counts,
+    retime_segments,
+    segment_vectors,
+    vectors_to_segments,
+)
+from skmotion.preprocessing._filter import filter_min_frames
+from skmotion.preprocessing._segment import segment_clip
+from skmotion.utils._clips import check_clips, to_container
+from skmotion.utils._parallel import parallel_map
+from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
+
+__all__ = ["EigenMovementPCA"]
+
+
+class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None):
+    """Eigenmovements: PCA of movement segments, each coded by a few numbers.
+
+    Each clip is cut into segments (strokes from rest to rest), each segment is
+    resampled to ``n_samples`` samples per channel with a cubic spline and
+    flattened channel after channel into one vector, and PCA over the training
+    segments gives the eigenmovements. A segment's code is its projection on
+    the first ``n_components`` of them. Reconstruction back-projects a code,
+    splits it per channel and stretches it to the segment's real duration with
+    a cubic spline.
+
+    Parameters
+    ----------
+    n_components : int or None, default=30
+        Eigenmovements kept; ``None`` keeps ``min(n_segments, n_features)``.
+    n_samples : int, default=100
+        Samples per channel of a resampled segment.
+    segmentation : {"energy", "zvc", "none"}, default="energy"
+        ``"energy"``: boundaries where the sum of squared velocities is low
+        (SEG-2, :func:`~skmotion.preprocessing.energy_segments`); ``"zvc"``:
+        zero-velocity crossings of several channels within ``zvc_window``
+        (SEG-1, :func:`~skmotion.preprocessing.zvc_segments`); ``"none"``: each
+        clip is one segment (for data cut into segments already).
+    frame_rate : float, default=None
+        Frames per second. Needed by ``"zvc"`` (its window is in seconds) and by
+        an explicit ``energy_threshold``; the automatic energy threshold does
+        not depend on it.
+    filter_order : int or None, default=10
+        Order of the zero-phase Butterworth low-pass applied before segmenting
+        (the segments themselves are cut from the unfiltered input); ``None``
+        segments the raw input.
+    filter_cutoff : float, default=0.25
+        Cutoff of that filter as a fraction of the Nyquist frequency.
+    energy_threshold : float, default=None
+        SEG-2 threshold in (units per second) squared; by default
+        ``energy_ratio`` times each clip's mean energy.
+    energy_ratio : float, default=0.1
+        The automatic SEG-2 threshold as a fraction of the clip's mean energy.
+    zvc_window : float, default=0.3
+        SEG-1: seconds within which crossings of different channels coincide.
+    zvc_min_channels : int, default=2
+        SEG-1: channels that must cross together to make a boundary.
+    min_movement : float, default=0.0
+        Both rules keep a segment only when some channel moves more than this
+        within it (input units); SEG-1 also ignores turning points of smaller
+        prominence.
+    n_jobs : int, default=None
+        Jobs over clips for segmenting and resampling (``None`` is serial).
+
+    Attributes
+    ----------
+    components_ : ndarray of shape (n_components_, n_channels * n_samples)
+        The eigenmovements, channel after channel; row ``i`` reshaped to
+        ``(n_channels, n_samples)`` is one time-normalised movement per channel.
+    explained_variance_ : ndarray of shape (n_components_,)
+        Eigenvalues of the kept eigenmovements (covariance divided by
+        ``n_segments_``).
+    explained_variance_ratio_ : ndarray of shape (n_components_,)
+        Their share of the total variance.
+    mean_ : ndarray of shape (n_channels * n_samples,)
+        The mean segment vector.
+    n_components_ : int
+        Number of eigenmovements kept.
+    n_segments_ : int
+        Number of training segments.
+    total_variance_ : float
+        Mean squared distance of the training segment vectors to ``mean_``.
+    projection_mse_ : float
+        Sum of the dropped eigenvalues: the mean over training segments of the
+        squared norm of the projection error (input units squared).
+    projection_rms_ : float
+        ``sqrt(projection_mse_ / (n_channels * n_samples))``: the RMS error per
+        sample of a projected training segment.
+    n_features_in_ : int
+        Number of channels seen in fit.
+    feature_names_in_ : ndarray of str
+        Channel names seen in fit, when given as DataFrame columns.
+
+    See Also
+    --------
+    skmotion.control.KMeansPrimitiveController : primitives from the codes.
+    skmotion.preprocessing.energy_segments : the SEG-2 rule.
+    skmotion.preprocessing.zvc_segments : the SEG-1 rule.
+
+    Notes
+    -----
+    ``transform`` returns one array of codes per clip, ``(n_segments_i,
+    n_components_)``, always as a list (clips differ in their number of
+    segments, and a clip may have none); :meth:`segment` gives the matching
+    ``(start, stop)`` frames. Errors are in the input's units: feed joint
+    angles in degrees to get the paper's degrees.
+
+    References
+    ----------
+    .. [1] Fod, Mataric and Jenkins, "Automated derivation of primitives for
+       movement classification", Autonomous Robots 12 (2002), 39-54.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.decomposition import EigenMovementPCA
+    >>> data = make_motions(n_clips_per_class=4, random_state=0)
+    >>> right_arm = [33, 34, 35, 37]  # RightArm Z, X, Y and RightForeArm X rotations
+    >>> arm = [np.rad2deg(c[:, right_arm]) for c in data.clips]  # in degrees
+    >>> pca = EigenMovementPCA(n_components=8).fit(arm)
+    >>> pca.components_.shape
+    (8, 400)
+    >>> codes = pca.transform(arm)
+    >>> len(codes) == len(arm), codes[0].shape[1]
+    (True, 8)
+    >>> bool(pca.score(arm) < 0)
+    True
+    """
+
+    _parameter_constraints = {
+        "n_components": [Interval(Integral, 1, None, closed="left"), None],
+        "n_samples": [Interval(Integral, 2, None, closed="left")],
+        "segmentation": [StrOptions({"energy", "zvc", "none"})],
+        "frame_rate": [Interval(Real, 0, None, closed="neither"), None],
+        "filter_order": [Interval(Integral, 1, None, closed="left"), None],
+        "filter_cutoff": [Interval(Real, 0, 1, closed="neither")],
+        "energy_threshold": [Interval(Real, 0, None, closed="left"), None],
+        "energy_ratio": [Interval(Real, 0, None, closed="left")],
+        "zvc_window": [Interval(Real, 0, None, closed="neither")],
+        "zvc_min_channels": [Interval(Integral, 1, None, closed="left")],
+        "min_movement": [Interval(Real, 0, None, closed="left")],
+        "n_jobs": [Integral, None],
+    }
+
+    def __init__(
+        self,
+        n_components=30,
+        *,
+        n_samples=100,
+        segmentation="energy",
+        frame_rate=None,
+        filter_order=10,
+        filter_cutoff=0.25,
+        energy_threshold=None,
+        energy_ratio=0.1,
+        zvc_window=0.3,
+        zvc_min_channels=2,
+        min_movement=0.0,
+        n_jobs=None,
+    ):
+        self.n_components = n_components
+        self.n_samples = n_samples
+        self.segmentation = segmentation
+        self.frame_rate = frame_rate
+        self.filter_order = filter_order
+        self.filter_cutoff = filter_cutoff
+        self.energy_threshold = energy_threshold
+        self.energy_ratio = energy_ratio
+        self.zvc_window = zvc_window
+        self.zvc_min_channels = zvc_min_channels
+        self.min_movement = min_movement
+        self.n_jobs = n_jobs
+
+    def __skmotion_tags__(self):
+        return MotionTags(output_kind="segments", min_frames=self._min_frames())
+
+    def _min_frames(self):
+        if self.segmentation == "none" or self.filter_order is None:
+            return 1
+        return filter_min_frames(self.filter_order, self.filter_cutoff)
+
+    # -- segmentation and vectors ---------------------------------------------------
+
+    def _segments_of(self, clip):
+        if self.segmentation == "none":
+            return np.array([[0, len(clip)]], dtype=np.intp)
+        return segment_clip(
+            clip,
+            rule=self.segmentation,
+            frame_rate=self.frame_rate,
+            filter_order=self.filter_order,
+            filter_cutoff=self.filter_cutoff,
+            energy_threshold=self.energy_threshold,
+            energy_ratio=self.energy_ratio,
+            zvc_window=self.zvc_window,
+            zvc_min_channels=self.zvc_min_channels,
+            min_movement=self.min_movement,
+        )
+
+    def _segment_all(self, clips):
+        return parallel_map(self._segments_of, clips, n_jobs=self.n_jobs)
+
+    def _vectors_all(self, clips, segments):
+        return segment_vectors(clips, segments, self.n_samples)
+
+    def _encode(self, vectors):
+        return (vectors - self.mean_) @ self.components_.T
+
+    def _decode(self, codes):
+        return codes @ self.components_ + self.mean_
+
+    # -- fitting -----------------------------------------------------------------------
+
+    def _fit(self, X):
+        clips = check_clips(X, estimator=self, reset=True, min_frames=self._min_frames())
+        segments = self._segment_all(clips)
+        per_clip = self._vectors_all(clips, segments)
+        vectors = np.concatenate(per_clip)
+        n_segments, n_features = vectors.shape
+        if n_segments == 0:
+            raise ValueError(
+                f"No segments were found in the {len(clips)} training clips; lower "
+                "min_movement or energy_ratio, or choose another segmentation."
+            )
+        limit = min(n_segments, n_features)
+        n_components = limit if self.n_components is None else self.n_components
+        if n_components > limit:
+            raise ValueError(
+                f"n_components={n_components} must be at most min(n_segments, n_features) = "
+                f"min({n_segments}, {n_features}) = {limit}: the {len(clips)} training clips "
+                f"gave {n_segments} segments."
+            )
+        mean, axes, eigenvalues = principal_axes(vectors, n_components)
+        self.mean_ = mean
+        self.components_ = axes
+        self.explained_variance_ = eigenvalues[:n_components]
+        self.total_variance_ = float(np.einsum("ij,ij->", vectors - mean, vectors - mean) / n_segments)
+        total = self.total_variance_
+        self.explained_variance_ratio_ = self.explained_variance_ / total if total > 0 else np.zeros(n_components)
+        self.projection_mse_ = float(eigenvalues[n_components:].sum())
+        self.projection_rms_ = float(np.sqrt(self.projection_mse_ / n_features))
+        self.n_components_ = n_components
+        self.n_segments_ = n_segments
+        return per_clip
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y=None):
+        """Segment the clips and find the eigenmovements of their segments.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        self : EigenMovementPCA
+            The fitted estimator.
+        """
+        self._fit(X)
+        return self
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit_transform(self, X, y=None):
+        """Fit, and return the codes of the training clips' segments.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        codes : list of ndarray of shape (n_segments_i, n_components_)
+            One array per clip.
+        """
+        return [self._encode(v) for v in self._fit(X)]
+
+    # -- per-clip queries ----------------------------------------------------------
+
+    def segment(self, X):
+        """The segments of each clip, as found by the segmentation rule.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+
+        Returns
+        -------
+        segments : list of ndarray of int of shape (n_segments_i, 2)
+            Per clip, ``(start, stop)`` of each segment (``clip[start:stop]``),
+            in the order of the rows of :meth:`transform`.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        return self._segment_all(clips)
+
+    def segment_vectors(self, X):
+        """The segments of each clip, resampled and flattened (what PCA sees).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+
+        Returns
+        -------
+        vectors : list of ndarray of shape (n_segments_i, n_channels * n_samples)
+            Per clip, one row per segment, channel after channel.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        return self._vectors_all(clips, self._segment_all(clips))
+
+    def transform(self, X):
+        """Code each segment of each clip by its eigenmovement coordinates.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+
+        Returns
+        -------
+        codes : list of ndarray of shape (n_segments_i, n_components_)
+            One array per clip, a row per segment (see :meth:`segment`).
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        return [self._encode(v) for v in self._vectors_all(clips, self._segment_all(clips))]
+
+    def inverse_transform(self, codes, segments=None, n_frames=None):
+        """Movement from codes: time-normalised segments, or clips re-timed.
+
+        Parameters
+        ----------
+        codes : list of ndarray of shape (n_segments_i, n_components_)
+            Per clip, one code per segment (as from :meth:`transform`).
+        segments : list of ndarray of int of shape (n_segments_i, 2), default=None
+            Per clip, ``(start, stop)`` of each segment (as from :meth:`segment`).
+            Without it each segment is returned on the normalised time scale.
+        n_frames : int or sequence of int, default=None
+            With ``segments``: the length of each rebuilt clip (by default the
+            last segment's stop).
+
+        Returns
+        -------
+        movement : list of ndarray
+            Without ``segments``, per clip an array ``(n_segments_i, n_samples,
+            n_channels)``; with them, per clip ``(n_frames_i, n_channels)``: each
+            segment stretched to ``stop - start`` frames by a cubic spline and put
+            in place, the mean of the two at a shared boundary frame, NaN in
+            frames no segment covers.
+        """
+        check_is_fitted(self)
+        codes = check_clips(codes, min_frames=0, input_name="codes")
+        if codes.n_channels != self.n_components_:
+            raise ValueError(
+                f"codes have {codes.n_channels} columns, but this EigenMovementPCA keeps "
+                f"n_components_={self.n_components_}."
+            )
+        normalised = [vectors_to_segments(self._decode(c), self.n_features_in_) for c in codes]
+        if segments is None:
+            if n_frames is not None:
+                raise ValueError("n_frames needs segments: without them, time is normalised.")
+            return normalised
+        segments = check_segments(segments, [len(c) for c in codes])
+        lengths = frame_counts(n_frames, segments)
+        return [self._place(*item) for item in zip(normalised, segments, lengths)]
+
+    def _place(self, normalised, segments, n_frames):
+        pieces = retime_segments(normalised, segments[:, 1] - segments[:, 0])
+        return assemble_segments(pieces, segments, n_frames, self.n_features_in_)
+
+    def _reconstruct(self, clips):
+        segments = self._segment_all(clips)
+        rebuilt = []
+        for clip, seg, vectors in zip(clips, segments, self._vectors_all(clips, segments)):
+            projected = vectors_to_segments(self._decode(self._encode(vectors)), self.n_features_in_)
+            rebuilt.append(self._place(projected, seg, len(clip)))
+        return rebuilt
+
+    def reconstruct(self, X):
+        """Segment, code and rebuild each clip from its eigenmovement codes.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+
+        Returns
+        -------
+        X_rebuilt : list of ndarray of shape (n_frames_i, n_channels)
+            In the container kind of ``X``; frames outside every segment are NaN.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        return to_container(self._reconstruct(clips), clips.container)
+
+    def score(self, X, y=None):
+        """Negative RMS reconstruction error, in the input's units.
+
+        The error is taken over every channel of every frame that some segment
+        covers (see :meth:`reconstruct`), at the clips' real timing.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        score : float
+            ``-sqrt(mean((x - x_rebuilt) ** 2))``; higher is better.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        diff = np.concatenate([c - r for c, r in zip(clips, self._reconstruct(clips))])
+        covered = ~np.isnan(diff)
+        if not covered.any():
+            raise ValueError(f"No segments were found in the {len(clips)} clips of X: nothing to score.")
+        return -float(np.sqrt(np.mean(diff[covered] ** 2)))
