@@ -48,14 +48,16 @@ def learn_delta(features, labels, quantile):
     component over its clips; then the ``quantile`` of these ranges over the
     labels. ``quantile=1`` is the maximum, the paper's ``delta_i``.
     """
-    spreads = [
-        features[labels == g].max(axis=0) - features[labels == g].min(axis=0)
-        for g in np.unique(labels)
-        if np.count_nonzero(labels == g) > 1
-    ]
-    if not spreads:
+    # One pass over the clips sorted by label (not one per label: a collection
+    # of repeated motions has about as many labels as clips).
+    _, codes, counts = np.unique(labels, return_inverse=True, return_counts=True)
+    order = np.argsort(codes.ravel(), kind="stable")
+    starts = np.r_[0, np.cumsum(counts)[:-1]]
+    ordered = features[order]
+    spreads = (np.maximum.reduceat(ordered, starts, axis=0) - np.minimum.reduceat(ordered, starts, axis=0))[counts > 1]
+    if not len(spreads):
         return np.zeros(features.shape[1])
-    return np.quantile(np.stack(spreads), quantile, axis=0)
+    return np.quantile(spreads, quantile, axis=0)
 
 
 def _extend(buffer, n, new):

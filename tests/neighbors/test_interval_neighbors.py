@@ -61,6 +61,18 @@ def test_delta_is_learned_from_labels():
     assert index.index_.n_entries == [34, 20]
 
 
+@given(st.integers(0, 10_000), st.integers(1, 30), st.sampled_from([0.0, 0.5, 0.9, 1.0]))
+def test_delta_equals_a_loop_over_the_labels(seed, n_labels, quantile):
+    rng = np.random.default_rng(seed)
+    features = rng.normal(size=(40, 3))
+    labels = rng.choice([f"m{i}" for i in range(n_labels)], size=40)
+    spreads = [
+        np.ptp(features[labels == g], axis=0) for g in np.unique(labels) if np.count_nonzero(labels == g) > 1
+    ]
+    expected = np.quantile(spreads, quantile, axis=0) if spreads else np.zeros(3)
+    np.testing.assert_allclose(learn_delta(features, labels, quantile), expected, rtol=1e-12, atol=1e-15)
+
+
 def _brute_force(index, queries):
     edges, radius = index.index_.edges, index.index_.radius
     return [brute_force_candidates(edges, radius, index._tree_features, q) for q in queries]
