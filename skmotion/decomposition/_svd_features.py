@@ -7,7 +7,7 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
-from skmotion.decomposition._clip_svd import clip_spectra
+from skmotion.decomposition._clip_svd import clip_spectra, small_blas
 from skmotion.utils._clips import check_clips
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
@@ -29,10 +29,11 @@ def _right_singular(matrix, n):
     clip, which an SVD would also compute, are never needed. Otherwise an SVD,
     whose cost then follows the number of rows.
     """
-    if matrix.shape[0] <= matrix.shape[1]:
-        _, singular, vt = np.linalg.svd(matrix, full_matrices=False)
-        return vt[:n], singular[:n]
-    values, vectors = np.linalg.eigh(matrix.T @ matrix)
+    with small_blas():  # small problems: threads would only wait for each other
+        if matrix.shape[0] <= matrix.shape[1]:
+            _, singular, vt = np.linalg.svd(matrix, full_matrices=False)
+            return vt[:n], singular[:n]
+        values, vectors = np.linalg.eigh(matrix.T @ matrix)
     return vectors[:, ::-1][:, :n].T, np.sqrt(np.clip(values[::-1][:n], 0.0, None))
 
 
