@@ -322,17 +322,20 @@ def make_search_scorer(min_recall=0.99):
 
     Examples
     --------
-    >>> from sklearn.model_selection import GridSearchCV
-    >>> from skmotion.datasets import make_motions
+    >>> import numpy as np
+    >>> from skmotion.datasets import make_repeated_motions
     >>> from skmotion.metrics import make_search_scorer
     >>> from skmotion.neighbors import IntervalIndexNeighbors
-    >>> data = make_motions(n_clips_per_class=6, random_state=0)
-    >>> clips = [c[:, 6:] for c in data.clips]
-    >>> search = GridSearchCV(
-    ...     IntervalIndexNeighbors(n_levels=4), {"epsilon": [0.6, 1.2]},
-    ...     scoring=make_search_scorer(0.9), refit="pruning_at_recall", cv=3,
-    ... ).fit(clips, data.target)
-    >>> sorted(k for k in search.cv_results_ if k.startswith("mean_test"))
-    ['mean_test_pruning', 'mean_test_pruning_at_recall', 'mean_test_recall']
+    >>> data = make_repeated_motions(n_motions_per_class=2, n_repeats=4, random_state=0)
+    >>> query = [k % 4 == 0 for k in range(len(data.clips))]  # one repetition of each motion
+    >>> stored = [c for c, q in zip(data.clips, query) if not q]
+    >>> queries = [c for c, q in zip(data.clips, query) if q]
+    >>> index = IntervalIndexNeighbors(n_levels=5).fit(stored, data.target[~np.array(query)])
+    >>> scores = make_search_scorer(0.9)(index, queries, data.target[query])
+    >>> sorted(scores), scores["recall"] >= 0.9
+    (['pruning', 'pruning_at_recall', 'recall'], True)
+
+    In a grid search: ``GridSearchCV(index, grid, scoring=make_search_scorer(0.9),
+    refit="pruning_at_recall")``.
     """
     return _SearchScores(min_recall)
