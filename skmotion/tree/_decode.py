@@ -1,0 +1,259 @@
+"""Decoding clips on a motion tree: the top-down beam Viterbi and its exhaustive reference.
+
+The probability of a node sequence ``n_1..n_M`` for frames ``x_1..x_M`` at one
+layer of the tree, under one transition graph (paper section IV-A), is::
+
+    P(N | X) = prod_i Pt(n_{i-1}, n_i) Ps(n_i | x_i),    Pt(n_0, n_1) = 1
+    Ps(k | x) = Po(x | k) P(k) / sum_j Po(x | j) P(j)
+
+with ``Po`` the node's Gaussian and ``P`` uniform over the *allowed* nodes: those
+the graph's clips visit (``node_prior="graph"``, the paper's choice) or every
+node of the layer (``node_prior="layer"``). Everything is computed in log space.
+
+:func:`beam_decode` searches top-down (paper section IV-A): every frame starts
+at the root, and going one layer down it may only move to a child of one of
+its kept nodes. :func:`exhaustive_viterbi` searches all nodes of a layer, for
+reference and small problems.
+"""
+
+import numpy as np
+from scipy.special import logsumexp
+
+from skmotion.tree._viterbi import kbest_viterbi, max_marginals
+
+__all__ = ["NODE_PRIORS", "beam_decode", "exhaustive_viterbi", "node_log_posterior"]
+
+#: Where the uniform node prior of ``Ps(k | x)`` is spread.
+NODE_PRIORS = ("graph", "layer")
+
+# Below this, a sum of exp() may have lost its precision to underflow; such
+# entries are recomputed exactly.
+_UNDERFLOW = 1e-200
+
+
+def _log_normaliser(log_po, allowed):
+    """``log sum_{j allowed in g} Po(x | j)`` for every frame and graph, ``(n_frames, n_graphs)``."""
+    top = log_po.max(axis=1, keepdims=True)
+    weights = np.exp(log_po - top) @ allowed.T.astype(np.float64)
+    with np.errstate(divide="ignore"):
+        out = np.log(weights) + top
+    rows, cols = np.nonzero(weights < _UNDERFLOW)
+    if len(rows):  # the graph's nodes are all far below the best node: sum exactly
+        out[rows, cols] = logsumexp(np.where(allowed[cols], log_po[rows], -np.inf), axis=1)
+    return out
+
+
+def _allowed_nodes(graphs, layer, node_prior):
+    """Which nodes each graph's prior covers, ``(n_graphs, K)``, or ``(1, K)`` for all."""
+    if node_prior == "graph":
+        return graphs.visits(layer) > 0
+    if node_prior == "layer":
+        return np.ones((1, graphs.n_nodes(layer)), dtype=bool)
+    raise ValueError(f"node_prior must be one of {NODE_PRIORS}; got {node_prior!r}.")
+
+
+def node_log_posterior(tree, graphs, layer, frames, node_prior="graph"):
+    """``log Ps(k | x)`` of every frame, node and graph of one layer.
+
+    Parameters
+    ----------
+    tree : MotionTree
+    graphs : TransitionGraphs
+    layer : int
+    frames : ndarray of shape (n_frames, n_channels)
+    node_prior : {"graph", "layer"}, default="graph"
+
+    Returns
+    -------
+    log_ps : ndarray of shape (n_graphs, n_frames, K)
+        ``-inf`` for nodes outside a graph's prior; ``logsumexp`` over the
+        nodes is 0 for every graph and frame.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree import MotionTree, TransitionGraphs, node_log_posterior
+    >>> frames = np.r_[np.zeros((20, 2)), np.ones((20, 2))] + np.arange(40)[:, None] * 1e-3
+    >>> tree = MotionTree.build(frames, min_samples_leaf=10, max_depth=1)
+    >>> graphs = TransitionGraphs.count(tree.iter_apply(frames), tree.n_nodes, offsets=[0, 40],
+    ...                                 graph_of_clip=[0])
+    >>> np.exp(node_log_posterior(tree, graphs, 1, frames[:1])).round(3).tolist()
+    [[[1.0, 0.0]]]
+    """
+    layer = tree.check_layer(layer)
+    log_po = tree.log_likelihood(frames, layer)
+    allowed = _allowed_nodes(graphs, layer, node_prior)
+    norm = _log_normaliser(log_po, allowed)
+    allowed = np.broadcast_to(allowed, (graphs.n_graphs, allowed.shape[1]))
+    norm = np.broadcast_to(norm, (len(frames), graphs.n_graphs))
+    return np.where(allowed[:, None, :], log_po[None] - norm.T[:, :, None], -np.inf)
+
+
+def exhaustive_viterbi(tree, graphs, layer, frames, graph=0, *, n_paths=1, node_prior="graph"):
+    """The ``n_paths`` best node sequences of one clip over *all* nodes of a layer.
+
+    The reference for :func:`beam_decode`: a K-best Viterbi whose states are
+    every node of the layer, costing ``O(n_frames K^2 n_paths)``.
+
+    Parameters
+    ----------
+    tree : MotionTree
+    graphs : TransitionGraphs
+    layer : int
+    frames : ndarray of shape (n_frames, n_channels)
+        One clip.
+    graph : int, default=0
+        Which graph of ``graphs``.
+    n_paths : int, default=1
+    node_prior : {"graph", "layer"}, default="graph"
+
+    Returns
+    -------
+    paths : ndarray of shape (n_paths, n_frames)
+        Node sequences (layer indices), best first; -1 rows when fewer exist.
+    scores : ndarray of shape (n_paths,)
+        Their log probabilities ``log P(N | X)``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree import MotionTree, TransitionGraphs, exhaustive_viterbi
+    >>> frames = np.r_[np.zeros((20, 2)), np.ones((20, 2))] + np.arange(40)[:, None] * 1e-3
+    >>> tree = MotionTree.build(frames, min_samples_leaf=10, max_depth=1)
+    >>> graphs = TransitionGraphs.count(tree.iter_apply(frames), tree.n_nodes, offsets=[0, 40],
+    ...                                 graph_of_clip=[0])
+    >>> paths, scores = exhaustive_viterbi(tree, graphs, 1, frames[18:22])
+    >>> paths.tolist()
+    [[0, 0, 1, 1]]
+    """
+    layer = tree.check_layer(layer)
+    emit = node_log_posterior(tree, graphs, layer, frames, node_prior)[graph]
+    nodes = np.arange(emit.shape[1])
+    trans = graphs.log_prob(layer, graph, nodes[:, None], nodes[None, :])
+    steps = (trans[None] + emit[1:, None, :])[:, None]
+    paths, scores = kbest_viterbi(emit[:1], steps, n_paths)
+    return paths[0], scores[0]
+
+
+def _unique_candidates(cand):
+    """Sort each row of candidates decreasing, blank repeats (-1), and trim the width."""
+    cand = -np.sort(-cand, axis=-1)
+    repeat = np.zeros(cand.shape, dtype=bool)
+    repeat[..., 1:] = cand[..., 1:] == cand[..., :-1]
+    cand[repeat] = -1
+    cand = -np.sort(-cand, axis=-1)
+    width = max(int((cand >= 0).sum(axis=-1).max()), 1)
+    return np.ascontiguousarray(cand[..., :width])
+
+
+def _trellis(tree, graphs, layer, frames, frame_idx, cand, graph_of_problem, allowed, pad, normalise):
+    """The candidates' trellis of one layer: ``(initial, steps)`` for :mod:`_viterbi`.
+
+    Without ``normalise`` the emissions are ``log Po(x | k)``: the normaliser of
+    ``Ps`` is the same for every node of a frame (within a graph), so it changes
+    no ranking and is only added at the last layer.
+    """
+    used, pos = np.unique(frame_idx, return_inverse=True)
+    pos = pos.reshape(frame_idx.shape)
+    log_po = tree.log_likelihood(frames[used], layer)
+    emit = log_po[pos[..., None], np.maximum(cand, 0)]
+    if normalise:
+        norm = _log_normaliser(log_po, allowed)
+        graph_col = graph_of_problem if allowed.shape[0] > 1 else np.zeros_like(graph_of_problem)
+        emit -= norm[pos, graph_col[None, :]][..., None]
+    emit[cand < 0] = -np.inf
+    steps = graphs.log_prob(layer, graph_of_problem[None, :, None, None], cand[:-1, :, :, None], cand[1:, :, None, :])
+    steps += emit[1:, :, None, :]
+    # A padded step repeats the last frame: identity moves of score 0.
+    steps[pad[1:]] = np.where(np.eye(cand.shape[2], dtype=bool), 0.0, -np.inf)
+    return emit[0], steps
+
+
+def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, *, layer, n_paths=5,
+                node_prior="graph"):
+    """Top-down beam Viterbi: the best node sequences of clips under graphs, layer by layer.
+
+    Every frame starts at the root. Going one layer down, a frame's candidates
+    are the children of its kept nodes; a max-product forward-backward pass over
+    these candidates scores each by the best sequence through it, and the
+    ``n_paths`` best of every frame are kept: a per-frame beam, the best
+    sequences through ``n_paths`` distinct nodes at each frame. At ``layer``, a
+    K-best Viterbi pass over the candidates gives the ``n_paths`` best
+    sequences. With ``n_paths`` at least the number of nodes of every layer
+    nothing is pruned, and the result is that of :func:`exhaustive_viterbi`.
+
+    Parameters
+    ----------
+    tree : MotionTree
+    graphs : TransitionGraphs
+    frames : ndarray of shape (n_frames, n_channels)
+        The frames of all clips, stacked.
+    offsets : ndarray of shape (n_clips + 1,)
+        Clip ``i`` is ``frames[offsets[i]:offsets[i + 1]]``.
+    clip_of_problem, graph_of_problem : ndarray of shape (n_problems,)
+        Each problem decodes one clip under one graph.
+    layer : int
+        The layer to stop at (the root is layer 0).
+    n_paths : int, default=5
+        Nodes kept per frame at each layer, and sequences returned.
+    node_prior : {"graph", "layer"}, default="graph"
+
+    Returns
+    -------
+    paths : ndarray of shape (n_problems, n_paths, max_frames)
+        Node sequences (layer indices) at ``layer``, best first; a problem's
+        sequences are valid up to its clip's length; -1 rows for missing ones.
+    scores : ndarray of shape (n_problems, n_paths)
+        Their log probabilities ``log P(N | X)`` (``-inf`` for missing sequences).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree import MotionTree, TransitionGraphs, beam_decode
+    >>> frames = np.r_[np.zeros((20, 2)), np.ones((20, 2))] + np.arange(40)[:, None] * 1e-3
+    >>> tree = MotionTree.build(frames, min_samples_leaf=10, max_depth=1)
+    >>> graphs = TransitionGraphs.count(tree.iter_apply(frames), tree.n_nodes, offsets=[0, 40],
+    ...                                 graph_of_clip=[0])
+    >>> paths, scores = beam_decode(tree, graphs, frames[18:22], [0, 4], [0], [0], layer=1, n_paths=1)
+    >>> paths[0].tolist()
+    [[0, 0, 1, 1]]
+    """
+    layer = tree.check_layer(layer)
+    offsets = np.asarray(offsets, dtype=np.intp)
+    clip_of_problem = np.asarray(clip_of_problem, dtype=np.intp)
+    graph_of_problem = np.asarray(graph_of_problem, dtype=np.intp)
+    lengths = np.diff(offsets)[clip_of_problem]
+    n_problems, n_steps = len(clip_of_problem), int(lengths.max())
+    steps = np.arange(n_steps)[:, None]
+    # Time-major throughout; short clips are padded by repeating their last frame.
+    frame_idx = offsets[clip_of_problem][None, :] + np.minimum(steps, lengths[None, :] - 1)
+    pad = steps >= lengths[None, :]
+    paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
+    paths[:, 0] = 0
+    scores = np.full((n_problems, n_paths), -np.inf)
+    scores[:, 0] = 0.0
+    beam = np.zeros((n_steps, n_problems, 1), dtype=np.intp)
+    for depth in range(1, layer + 1):
+        children = tree.children(depth - 1)
+        cand = np.where(beam[..., None] >= 0, children[np.maximum(beam, 0)], -1).reshape(n_steps, n_problems, -1)
+        allowed = _allowed_nodes(graphs, depth, node_prior)
+        if allowed.shape[0] > 1:
+            cand = np.where(allowed[graph_of_problem[None, :, None], np.maximum(cand, 0)], cand, -1)
+        cand = _unique_candidates(cand)
+        last = depth == layer
+        if not last and cand.shape[2] <= n_paths:
+            beam = cand  # the beam keeps every candidate: nothing to score
+            continue
+        initial, moves = _trellis(tree, graphs, depth, frames, frame_idx, cand, graph_of_problem, allowed, pad,
+                                  normalise=last)
+        if last:
+            slots, scores = kbest_viterbi(initial, moves, n_paths)
+            cand_bt = cand.transpose(1, 0, 2)
+            paths = np.take_along_axis(cand_bt[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
+            paths[slots < 0] = -1
+        else:
+            marginals = max_marginals(initial, moves)
+            keep = np.argsort(-marginals, axis=2, kind="stable")[:, :, :n_paths]
+            beam = np.take_along_axis(cand, keep, axis=2)
+            beam[~np.isfinite(np.take_along_axis(marginals, keep, axis=2))] = -1
+    return paths, scores
