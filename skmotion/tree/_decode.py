@@ -130,42 +130,46 @@ def exhaustive_viterbi(tree, graphs, layer, frames, graph=0, *, n_paths=1, node_
     emit = node_log_posterior(tree, graphs, layer, frames, node_prior)[graph]
     nodes = np.arange(emit.shape[1])
     trans = graphs.log_prob(layer, graph, nodes[:, None], nodes[None, :])
-    steps = (trans[None] + emit[1:, None, :])[:, None]
-    paths, scores = kbest_viterbi(emit[:1], steps, n_paths)
+    steps = (trans[None] + emit[1:, None, :])[..., None]
+    paths, scores = kbest_viterbi(emit[0][:, None], steps, n_paths)
     return paths[0], scores[0]
 
 
-def _unique_candidates(cand):
-    """Sort each row of candidates decreasing, blank repeats (-1), and trim the width."""
-    cand = -np.sort(-cand, axis=-1)
-    repeat = np.zeros(cand.shape, dtype=bool)
-    repeat[..., 1:] = cand[..., 1:] == cand[..., :-1]
-    cand[repeat] = -1
-    cand = -np.sort(-cand, axis=-1)
-    width = max(int((cand >= 0).sum(axis=-1).max()), 1)
-    return np.ascontiguousarray(cand[..., :width])
+def _trim_candidates(cand, none):
+    """Drop candidate slots that hold no node at any step of any problem.
+
+    The children of distinct nodes are distinct, so the candidates of a frame
+    never repeat; only "no node" entries (``none``) can, and slots of nothing
+    but those are dropped.
+    """
+    used = (cand != none).any(axis=(0, 2))
+    used[0] = True
+    return cand if used.all() else np.ascontiguousarray(cand[:, used])
 
 
-def _trellis(tree, graphs, layer, frames, frame_idx, cand, graph_of_problem, allowed, pad, normalise):
+def _trellis(tree, graphs, layer, frames, pos, cand, graph_of_problem, allowed, pad, normalise):
     """The candidates' trellis of one layer: ``(initial, steps)`` for :mod:`_viterbi`.
 
-    Without ``normalise`` the emissions are ``log Po(x | k)``: the normaliser of
-    ``Ps`` is the same for every node of a frame (within a graph), so it changes
-    no ranking and is only added at the last layer.
+    ``cand`` is ``(n_steps, n_candidates, n_problems)`` node indices, ``K`` for
+    "no candidate". Without ``normalise`` the emissions are ``log Po(x | k)``:
+    the normaliser of ``Ps`` is the same for every node of a frame (within a
+    graph), so it changes no ranking and is only added at the last layer.
     """
-    used, pos = np.unique(frame_idx, return_inverse=True)
-    pos = pos.reshape(frame_idx.shape)
-    log_po = tree.log_likelihood(frames[used], layer)
-    emit = log_po[pos[..., None], np.maximum(cand, 0)]
+    k = graphs.n_nodes(layer)
+    log_po = np.empty((len(frames), k + 1))
+    log_po[:, :k] = tree.log_likelihood(frames, layer)
+    log_po[:, k] = -np.inf
+    emit = log_po.ravel().take(pos[:, None, :] * (k + 1) + cand)
     if normalise:
-        norm = _log_normaliser(log_po, allowed)
+        norm = _log_normaliser(log_po[:, :k], allowed)
         graph_col = graph_of_problem if allowed.shape[0] > 1 else np.zeros_like(graph_of_problem)
-        emit -= norm[pos, graph_col[None, :]][..., None]
-    emit[cand < 0] = -np.inf
-    steps = graphs.log_prob(layer, graph_of_problem[None, :, None, None], cand[:-1, :, :, None], cand[1:, :, None, :])
-    steps += emit[1:, :, None, :]
+        emit -= norm[pos, graph_col[None, :]][:, None, :]
+    steps = graphs.log_prob(layer, graph_of_problem, cand[:-1, :, None, :], cand[1:, None, :, :])
+    steps += emit[1:, None, :, :]
     # A padded step repeats the last frame: identity moves of score 0.
-    steps[pad[1:]] = np.where(np.eye(cand.shape[2], dtype=bool), 0.0, -np.inf)
+    t, b = np.nonzero(pad[1:])
+    identity = np.where(np.eye(cand.shape[1], dtype=bool), 0.0, -np.inf)
+    steps[t, :, :, b] = identity
     return emit[0], steps
 
 
@@ -225,35 +229,42 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     lengths = np.diff(offsets)[clip_of_problem]
     n_problems, n_steps = len(clip_of_problem), int(lengths.max())
     steps = np.arange(n_steps)[:, None]
-    # Time-major throughout; short clips are padded by repeating their last frame.
+    # Time first, problems last; short clips are padded by repeating their last frame.
     frame_idx = offsets[clip_of_problem][None, :] + np.minimum(steps, lengths[None, :] - 1)
+    used, pos = np.unique(frame_idx, return_inverse=True)
+    pos = pos.reshape(frame_idx.shape)
+    frames = np.asarray(frames, dtype=np.float64)[used]
     pad = steps >= lengths[None, :]
     paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
     paths[:, 0] = 0
     scores = np.full((n_problems, n_paths), -np.inf)
     scores[:, 0] = 0.0
-    beam = np.zeros((n_steps, n_problems, 1), dtype=np.intp)
+    beam = np.zeros((n_steps, 1, n_problems), dtype=np.intp)
     for depth in range(1, layer + 1):
-        children = tree.children(depth - 1)
-        cand = np.where(beam[..., None] >= 0, children[np.maximum(beam, 0)], -1).reshape(n_steps, n_problems, -1)
+        # Node index K of a layer stands for "no node"; its children are none too.
+        k = graphs.n_nodes(depth)
+        children = np.full((graphs.n_nodes(depth - 1) + 1, 2), k, dtype=np.intp)
+        children[:-1] = np.where(tree.children(depth - 1) >= 0, tree.children(depth - 1), k)
+        cand = np.concatenate([children[:, 0][beam], children[:, 1][beam]], axis=1)
         allowed = _allowed_nodes(graphs, depth, node_prior)
         if allowed.shape[0] > 1:
-            cand = np.where(allowed[graph_of_problem[None, :, None], np.maximum(cand, 0)], cand, -1)
-        cand = _unique_candidates(cand)
+            ok = np.append(allowed, np.zeros((len(allowed), 1), dtype=bool), axis=1)
+            cand = np.where(ok.ravel().take(graph_of_problem * (k + 1) + cand), cand, k)
+        cand = _trim_candidates(cand, k)
         last = depth == layer
-        if not last and cand.shape[2] <= n_paths:
+        if not last and cand.shape[1] <= n_paths:
             beam = cand  # the beam keeps every candidate: nothing to score
             continue
-        initial, moves = _trellis(tree, graphs, depth, frames, frame_idx, cand, graph_of_problem, allowed, pad,
+        initial, moves = _trellis(tree, graphs, depth, frames, pos, cand, graph_of_problem, allowed, pad,
                                   normalise=last)
         if last:
             slots, scores = kbest_viterbi(initial, moves, n_paths)
-            cand_bt = cand.transpose(1, 0, 2)
-            paths = np.take_along_axis(cand_bt[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
+            nodes = cand.transpose(2, 0, 1)  # (problem, step, candidate)
+            paths = np.take_along_axis(nodes[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
             paths[slots < 0] = -1
         else:
             marginals = max_marginals(initial, moves)
-            keep = np.argsort(-marginals, axis=2, kind="stable")[:, :, :n_paths]
-            beam = np.take_along_axis(cand, keep, axis=2)
-            beam[~np.isfinite(np.take_along_axis(marginals, keep, axis=2))] = -1
+            keep = np.argsort(-marginals, axis=1, kind="stable")[:, :n_paths]
+            beam = np.take_along_axis(cand, keep, axis=1)
+            beam[np.take_along_axis(marginals, keep, axis=1) == -np.inf] = k
     return paths, scores

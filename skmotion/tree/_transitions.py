@@ -116,19 +116,27 @@ class TransitionGraphs:
         return cls(counts, visits, smoothing)
 
     def _dense_log(self, layer):
-        if self.n_graphs * self.n_nodes(layer) ** 2 > _DENSE_LIMIT:
-            return None
+        """The flat log table ``(n_graphs, K + 1, K + 1)``; index ``K`` is "no node" (-inf)."""
         k = self.n_nodes(layer)
-        table = self._counts[layer].toarray().reshape(self.n_graphs, k, k).astype(np.float64)
+        if self.n_graphs * (k + 1) ** 2 > _DENSE_LIMIT:
+            return None
+        table = np.zeros((self.n_graphs, k + 1, k + 1))
+        table[:, :k, :k] = self._counts[layer].toarray().reshape(self.n_graphs, k, k)
         table += self.smoothing
-        table /= (self._totals[layer] + self.smoothing * k)[:, :, None]
-        return np.log(table).ravel()
+        with np.errstate(divide="ignore"):
+            table[:, :k, :k] /= (self._totals[layer] + self.smoothing * k)[:, :, None]
+            table = np.log(table)
+        table[:, k, :] = -np.inf
+        table[:, :, k] = -np.inf
+        return table.ravel()
 
     def _sorted_keys(self, layer):
-        """``row * K + column`` of every stored count, increasing (CSR order)."""
+        """Flat index in the ``(n_graphs, K + 1, K + 1)`` table of every stored count, increasing."""
         csr = self._counts[layer]
+        k = csr.shape[1]
         rows = np.repeat(np.arange(csr.shape[0], dtype=np.int64), np.diff(csr.indptr))
-        return rows * csr.shape[1] + csr.indices
+        graph, src = np.divmod(rows, k)
+        return (graph * (k + 1) + src) * (k + 1) + csr.indices
 
     def n_nodes(self, layer):
         """Number of nodes of a layer."""
@@ -158,29 +166,30 @@ class TransitionGraphs:
         ----------
         layer : int
         graph, src, dst : array-like of int
-            Graph and node indices (broadcast together). A negative node
-            index means "no node" and gives ``-inf``.
+            Graph and node indices (broadcast together). A node index that is
+            negative or equal to the number of nodes ``K`` means "no node" and
+            gives ``-inf``.
 
         Returns
         -------
         log_p : ndarray
         """
-        src = np.asarray(src, dtype=np.intp)
-        dst = np.asarray(dst, dtype=np.intp)
         k = self.n_nodes(layer)
-        row = np.asarray(graph, dtype=np.intp) * k + np.maximum(src, 0)
-        flat = row * k + np.maximum(dst, 0)
+        src, dst = (np.asarray(a, dtype=np.intp) for a in (src, dst))
+        src, dst = (np.where(a < 0, k, a) if a.size and a.min() < 0 else a for a in (src, dst))
+        row = np.asarray(graph, dtype=np.intp) * (k + 1) + src
+        flat = row * (k + 1) + dst
         if self._dense[layer] is not None:
-            out = self._dense[layer].take(flat)
-        else:
-            keys, data = self._keys[layer], self._counts[layer].data
-            t = np.zeros(flat.shape)
-            if len(keys):
-                pos = np.minimum(np.searchsorted(keys, flat), len(keys) - 1)
-                t = np.where(keys[pos] == flat, data[pos], 0)
-            totals = self._totals[layer].ravel()
+            return self._dense[layer].take(flat)
+        keys, data = self._keys[layer], self._counts[layer].data
+        t = np.zeros(flat.shape)
+        if len(keys):
+            pos = np.minimum(np.searchsorted(keys, flat), len(keys) - 1)
+            t = np.where(keys[pos] == flat, data[pos], 0)
+        totals = np.append(self._totals[layer], np.zeros((self.n_graphs, 1)), axis=1).ravel()
+        with np.errstate(divide="ignore"):
             out = np.log((t + self.smoothing) / (totals.take(row) + self.smoothing * k))
-        out[(src < 0) | (dst < 0)] = -np.inf
+        out[np.broadcast_to((src == k) | (dst == k), out.shape)] = -np.inf
         return out
 
     def matrix(self, layer, graph):
