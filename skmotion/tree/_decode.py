@@ -156,14 +156,19 @@ def _trellis(tree, graphs, layer, frames, pos, cand, graph_of_problem, allowed, 
     graph), so it changes no ranking and is only added at the last layer.
     """
     k = graphs.n_nodes(layer)
-    log_po = np.empty((len(frames), k + 1))
-    log_po[:, :k] = tree.log_likelihood(frames, layer)
-    log_po[:, k] = -np.inf
-    emit = log_po.ravel().take(pos[:, None, :] * (k + 1) + cand)
     if normalise:
+        log_po = np.empty((len(frames), k + 1))
+        log_po[:, :k] = tree.log_likelihood(frames, layer)
+        log_po[:, k] = -np.inf
+        emit = log_po.ravel().take(pos[:, None, :] * (k + 1) + cand)
         norm = _log_normaliser(log_po[:, :k], allowed)
         graph_col = graph_of_problem if allowed.shape[0] > 1 else np.zeros_like(graph_of_problem)
         emit -= norm[pos, graph_col[None, :]][:, None, :]
+    else:  # only the candidates' densities: far fewer than every node on every frame
+        rows = np.broadcast_to(pos[:, None, :], cand.shape)
+        real = cand < k
+        emit = np.full(cand.shape, -np.inf)
+        emit[real] = tree.log_likelihood_pairs(frames[rows[real]], layer, cand[real])
     steps = graphs.log_prob(layer, graph_of_problem, cand[:-1, :, None, :], cand[1:, None, :, :])
     steps += emit[1:, None, :, :]
     # A padded step repeats the last frame: identity moves of score 0.
@@ -173,8 +178,56 @@ def _trellis(tree, graphs, layer, frames, pos, cand, graph_of_problem, allowed, 
     return emit[0], steps
 
 
+def _candidates(tree, graphs, depth, beam, graph_of_problem, node_prior):
+    """Children (in layer ``depth``) of the kept nodes, ``(n_steps, n_candidates, n_problems)``.
+
+    Node index ``K`` of a layer stands for "no node"; its children are none too.
+    """
+    k = graphs.n_nodes(depth)
+    kids = tree.children(depth - 1)
+    children = np.full((len(kids) + 1, 2), k, dtype=np.intp)
+    children[:-1] = np.where(kids >= 0, kids, k)
+    cand = np.concatenate([children[:, 0][beam], children[:, 1][beam]], axis=1)
+    allowed = _allowed_nodes(graphs, depth, node_prior)
+    if allowed.shape[0] > 1:
+        ok = np.append(allowed, np.zeros((len(allowed), 1), dtype=bool), axis=1)
+        cand = np.where(ok.ravel().take(graph_of_problem * (k + 1) + cand), cand, k)
+    return _trim_candidates(cand, k), allowed
+
+
+def _layout(offsets, clip_of_problem):
+    """Frame bookkeeping of a batch, time first and problems last.
+
+    Short clips are padded by repeating their last frame (``pad`` marks those
+    steps). Returns the positions of each step's frame in ``used`` (the sorted
+    frame indices the batch needs), ``used`` and ``pad``.
+    """
+    lengths = np.diff(offsets)[clip_of_problem]
+    steps = np.arange(int(lengths.max()))[:, None]
+    frame_idx = offsets[clip_of_problem][None, :] + np.minimum(steps, lengths[None, :] - 1)
+    used, pos = np.unique(frame_idx, return_inverse=True)
+    return pos.reshape(frame_idx.shape), used, steps >= lengths[None, :]
+
+
+def _descend(tree, graphs, frames, pos, pad, graph_of_problem, *, layer, n_paths, node_prior):
+    """The per-frame beam at ``layer``: each frame's ``n_paths`` best nodes, ``(n_steps, width, n_problems)``."""
+    beam = np.zeros((pos.shape[0], 1, pos.shape[1]), dtype=np.intp)
+    for depth in range(1, layer + 1):
+        cand, allowed = _candidates(tree, graphs, depth, beam, graph_of_problem, node_prior)
+        if cand.shape[1] <= n_paths:
+            beam = cand  # the beam keeps every candidate: nothing to score
+            continue
+        initial, moves = _trellis(tree, graphs, depth, frames, pos, cand, graph_of_problem, allowed, pad,
+                                  normalise=False)
+        marginals = max_marginals(initial, moves)
+        keep = np.argsort(-marginals, axis=1, kind="stable")[:, :n_paths]
+        beam = np.take_along_axis(cand, keep, axis=1)
+        beam[np.take_along_axis(marginals, keep, axis=1) == -np.inf] = graphs.n_nodes(depth)
+    return beam
+
+
 def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, *, layer, n_paths=5,
-                node_prior="graph"):
+                node_prior="graph", guide=None):
     """Top-down beam Viterbi: the best node sequences of clips under graphs, layer by layer.
 
     Every frame starts at the root. Going one layer down, a frame's candidates
@@ -201,6 +254,12 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     n_paths : int, default=5
         Nodes kept per frame at each layer, and sequences returned.
     node_prior : {"graph", "layer"}, default="graph"
+    guide : TransitionGraphs, default=None
+        When given (one graph, e.g. the global graph), the layers above
+        ``layer`` are searched once per clip under it, and every problem's
+        graph only runs the last K-best pass on the candidates this shared
+        beam leaves: much faster with many graphs, and the same with a wide
+        beam. By default each problem searches under its own graph.
 
     Returns
     -------
@@ -226,45 +285,28 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     offsets = np.asarray(offsets, dtype=np.intp)
     clip_of_problem = np.asarray(clip_of_problem, dtype=np.intp)
     graph_of_problem = np.asarray(graph_of_problem, dtype=np.intp)
-    lengths = np.diff(offsets)[clip_of_problem]
-    n_problems, n_steps = len(clip_of_problem), int(lengths.max())
-    steps = np.arange(n_steps)[:, None]
-    # Time first, problems last; short clips are padded by repeating their last frame.
-    frame_idx = offsets[clip_of_problem][None, :] + np.minimum(steps, lengths[None, :] - 1)
-    used, pos = np.unique(frame_idx, return_inverse=True)
-    pos = pos.reshape(frame_idx.shape)
-    frames = np.asarray(frames, dtype=np.float64)[used]
-    pad = steps >= lengths[None, :]
-    paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
-    paths[:, 0] = 0
-    scores = np.full((n_problems, n_paths), -np.inf)
-    scores[:, 0] = 0.0
-    beam = np.zeros((n_steps, 1, n_problems), dtype=np.intp)
-    for depth in range(1, layer + 1):
-        # Node index K of a layer stands for "no node"; its children are none too.
-        k = graphs.n_nodes(depth)
-        children = np.full((graphs.n_nodes(depth - 1) + 1, 2), k, dtype=np.intp)
-        children[:-1] = np.where(tree.children(depth - 1) >= 0, tree.children(depth - 1), k)
-        cand = np.concatenate([children[:, 0][beam], children[:, 1][beam]], axis=1)
-        allowed = _allowed_nodes(graphs, depth, node_prior)
-        if allowed.shape[0] > 1:
-            ok = np.append(allowed, np.zeros((len(allowed), 1), dtype=bool), axis=1)
-            cand = np.where(ok.ravel().take(graph_of_problem * (k + 1) + cand), cand, k)
-        cand = _trim_candidates(cand, k)
-        last = depth == layer
-        if not last and cand.shape[1] <= n_paths:
-            beam = cand  # the beam keeps every candidate: nothing to score
-            continue
-        initial, moves = _trellis(tree, graphs, depth, frames, pos, cand, graph_of_problem, allowed, pad,
-                                  normalise=last)
-        if last:
-            slots, scores = kbest_viterbi(initial, moves, n_paths)
-            nodes = cand.transpose(2, 0, 1)  # (problem, step, candidate)
-            paths = np.take_along_axis(nodes[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
-            paths[slots < 0] = -1
-        else:
-            marginals = max_marginals(initial, moves)
-            keep = np.argsort(-marginals, axis=1, kind="stable")[:, :n_paths]
-            beam = np.take_along_axis(cand, keep, axis=1)
-            beam[np.take_along_axis(marginals, keep, axis=1) == -np.inf] = k
+    frames = np.asarray(frames, dtype=np.float64)
+    pos, used, pad = _layout(offsets, clip_of_problem)
+    n_problems, n_steps = len(clip_of_problem), pos.shape[0]
+    if layer == 0:
+        paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
+        paths[:, 0] = 0
+        scores = np.full((n_problems, n_paths), -np.inf)
+        scores[:, 0] = 0.0
+        return paths, scores
+    if guide is None:
+        beam = _descend(tree, graphs, frames[used], pos, pad, graph_of_problem, layer=layer - 1,
+                        n_paths=n_paths, node_prior=node_prior)
+    else:
+        clips, inverse = np.unique(clip_of_problem, return_inverse=True)
+        clip_pos, clip_used, clip_pad = _layout(offsets, clips)
+        beam = _descend(tree, guide, frames[clip_used], clip_pos, clip_pad, np.zeros(len(clips), dtype=np.intp),
+                        layer=layer - 1, n_paths=n_paths, node_prior=node_prior)[:, :, inverse]
+    cand, allowed = _candidates(tree, graphs, layer, beam, graph_of_problem, node_prior)
+    initial, moves = _trellis(tree, graphs, layer, frames[used], pos, cand, graph_of_problem, allowed, pad,
+                              normalise=True)
+    slots, scores = kbest_viterbi(initial, moves, n_paths)
+    nodes = cand.transpose(2, 0, 1)  # (problem, step, candidate)
+    paths = np.take_along_axis(nodes[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
+    paths[slots < 0] = -1
     return paths, scores

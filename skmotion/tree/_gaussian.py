@@ -88,8 +88,8 @@ def estimate_covariance(centred, kind, reg, scatter=None):
     """
     n = len(centred)
     if kind == "diag":
-        variances = np.einsum("ij,ij->j", centred, centred) / n
-        return variances + reg
+        squares = np.diag(scatter) if scatter is not None else np.einsum("ij,ij->j", centred, centred)
+        return squares / n + reg
     if kind == "spherical":
         return float(np.einsum("ij,ij->", centred, centred) / centred.size + reg)
     if kind == "full":
@@ -172,6 +172,37 @@ class Gaussians:
         out = np.empty((len(X), len(nodes)))
         for start in range(0, len(X), step):
             out[start : start + step] = self._log_pdf_block(X[start : start + step], nodes)
+        return out
+
+    def log_pdf_pairs(self, X, nodes):
+        """Log density of frame ``i`` under Gaussian ``nodes[i]``, for every ``i``.
+
+        Cheaper than :meth:`log_pdf` when only a few Gaussians matter per frame.
+
+        Parameters
+        ----------
+        X : ndarray of shape (n_pairs, n_channels)
+        nodes : ndarray of shape (n_pairs,)
+
+        Returns
+        -------
+        log_pdf : ndarray of shape (n_pairs,)
+        """
+        X = np.asarray(X, dtype=np.float64)
+        nodes = np.asarray(nodes, dtype=np.intp)
+        d = X.shape[1]
+        step = max(1, _CHUNK_ELEMENTS // (d * d if self.kind == "full" else d))
+        out = np.empty(len(X))
+        for start in range(0, len(X), step):
+            x, k = X[start : start + step], nodes[start : start + step]
+            if self.kind == "full":
+                y = np.einsum("pd,pde->pe", x, self._prec_chol[k]) - self._shifts[k]
+                maha = np.einsum("pe,pe->p", y, y)
+            else:
+                diff = x - self.means[k]
+                prec = self._precisions[k] if self.kind == "diag" else self._precisions[k][:, None]
+                maha = np.einsum("pd,pd->p", diff * diff, np.broadcast_to(prec, diff.shape))
+            out[start : start + step] = self._const[k] - 0.5 * maha
         return out
 
     def _log_pdf_block(self, X, nodes):

@@ -21,8 +21,9 @@ from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["MotionTreeHMM"]
 
-# Clips are decoded in groups of about this many (frame, graph) pairs. The groups
-# depend on the data only, so results are the same for any n_jobs.
+# Clips are decoded in groups of at most this many (step, graph) pairs, counting
+# the padding of shorter clips to the longest of the group. Groups depend on the
+# data only, so results are the same for any n_jobs.
 _CHUNK_PAIRS = 1 << 17
 
 
@@ -33,11 +34,19 @@ def _check_count(name, value, low=1):
 
 
 def _chunks(lengths, n_graphs):
-    """Consecutive groups of clips holding about ``_CHUNK_PAIRS`` frame-graph pairs each."""
-    cost = np.cumsum(lengths * n_graphs)
-    group = cost // _CHUNK_PAIRS
-    bounds = np.flatnonzero(np.diff(group)) + 1
-    return np.split(np.arange(len(lengths)), bounds)
+    """Groups of clips of similar lengths, so little padding is decoded.
+
+    Clips are taken shortest first; a group grows while (its longest clip) x
+    (its clips) x ``n_graphs`` stays within ``_CHUNK_PAIRS``.
+    """
+    order = np.argsort(lengths, kind="stable")
+    groups, start = [], 0
+    for end in range(1, len(order) + 1):
+        if end - start > 1 and lengths[order[end - 1]] * (end - start) * n_graphs > _CHUNK_PAIRS:
+            groups.append(order[start : end - 1])
+            start = end - 1
+    groups.append(order[start:])
+    return groups
 
 
 class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -276,14 +285,18 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             graph_of_problem = np.tile(np.arange(n_graphs), len(chunk))
             paths, scores = beam_decode(
                 self.tree_, graphs, frames, offsets, clip_of_problem, graph_of_problem,
-                layer=layer, n_paths=self.n_paths, node_prior=self.node_prior,
+                layer=layer, n_paths=self.n_paths, node_prior=self.node_prior, guide=self.global_graph_,
             )
             return paths.reshape(len(chunk), n_graphs, *paths.shape[1:]), scores.reshape(len(chunk), n_graphs, -1)
 
-        results = parallel_map(work, _chunks(lengths, n_graphs), n_jobs=self.n_jobs)
-        paths = [p[i, :, :, : lengths[c]] for (p, _), chunk in zip(results, _chunks(lengths, n_graphs))
-                 for i, c in enumerate(chunk)]
-        scores = np.concatenate([s for _, s in results])
+        chunks = _chunks(lengths, n_graphs)
+        results = parallel_map(work, chunks, n_jobs=self.n_jobs)
+        paths = [None] * len(clips)
+        scores = np.empty((len(clips), n_graphs, self.n_paths))
+        for (chunk_paths, chunk_scores), chunk in zip(results, chunks):
+            scores[chunk] = chunk_scores
+            for i, c in enumerate(chunk):
+                paths[c] = chunk_paths[i, :, :, : lengths[c]]
         return paths, scores
 
     def _graph_log_probs(self, clips):

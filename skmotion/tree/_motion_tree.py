@@ -57,17 +57,20 @@ def _principal_axis(centred, scatter):
 
 
 class _Builder:
-    """Breadth-first construction; each node's frames are one slice of ``perm``."""
+    """Breadth-first construction on a copy of the frames in which every node's
+    frames are one contiguous block (splitting a node reorders its block)."""
 
     def __init__(self, X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg):
-        self.X = X
+        # Rounding of a projection x @ axis is below d * eps * max|x|; cuts must
+        # sit in gaps far wider, so a training frame always routes back to its side.
+        self.tol = _GAP_RESOLUTION * X.shape[1] * float(np.abs(X).max())
+        self.blocks = X.copy()
         self.max_depth = max_depth
         self.min_split = max(min_samples_split, 2 * min_samples_leaf, 2)
         self.min_leaf = min_samples_leaf
         self.split = split
         self.kind = covariance_type
         self.reg = reg
-        self.perm = np.arange(len(X))
         self.nodes = {k: [] for k in ("parent", "depth", "start", "stop", "mean", "cov", "axis", "thr", "left", "right")}
 
     def add(self, parent, depth, start, stop):
@@ -81,11 +84,10 @@ class _Builder:
         """Compute the node's Gaussian; split it when allowed and possible."""
         nodes = self.nodes
         start, stop = nodes["start"][node], nodes["stop"][node]
-        idx = self.perm[start:stop]
-        frames = self.X[idx]
-        n, d = frames.shape
-        mean = frames.mean(axis=0)
-        centred = frames - mean
+        block = self.blocks[start:stop]
+        n, d = block.shape
+        mean = block.mean(axis=0)
+        centred = block - mean
         eligible = may_split and n >= self.min_split
         scatter = centred.T @ centred if (self.kind == "full" or (eligible and n >= d)) else None
         nodes["mean"][node] = mean
@@ -95,14 +97,14 @@ class _Builder:
         axis = _principal_axis(centred, scatter if n >= d else None)
         if axis is None:
             return ()
-        proj = frames @ axis
+        proj = centred @ axis
+        proj += mean @ axis  # the projection of the frames themselves, as routing computes it
         order = np.argsort(proj, kind="stable")
         ordered = proj[order]
-        tol = _GAP_RESOLUTION * d * float(np.abs(frames).max())
-        n_left = best_split(ordered, self.split, min_samples_leaf=self.min_leaf, tol=tol)
+        n_left = best_split(ordered, self.split, min_samples_leaf=self.min_leaf, tol=self.tol)
         if n_left is None:
             return ()
-        self.perm[start:stop] = idx[order]
+        self.blocks[start:stop] = block[order]
         depth = nodes["depth"][node] + 1
         left = self.add(node, depth, start, start + n_left)
         right = self.add(node, depth, start + n_left, stop)
@@ -112,7 +114,7 @@ class _Builder:
         return (left, right)
 
     def run(self):
-        root = self.add(-1, 0, 0, len(self.X))
+        root = self.add(-1, 0, 0, len(self.blocks))
         layers = [np.array([root])]
         depth = 0
         while True:
@@ -442,6 +444,23 @@ class MotionTree:
         if nodes is not None:
             ids = ids[np.asarray(nodes, dtype=np.intp)]
         return self._gaussians.log_pdf(self._check_frames(frames), ids)
+
+    def log_likelihood_pairs(self, frames, layer, nodes):
+        """``log Po(frames[i] | nodes[i])`` for pairs of frames and nodes of a layer.
+
+        Parameters
+        ----------
+        frames : array-like of shape (n_pairs, n_channels)
+        layer : int
+        nodes : array-like of int of shape (n_pairs,)
+            Layer indices of the nodes.
+
+        Returns
+        -------
+        log_pdf : ndarray of shape (n_pairs,)
+        """
+        ids = self.node_ids(layer)[np.asarray(nodes, dtype=np.intp)]
+        return self._gaussians.log_pdf_pairs(self._check_frames(frames), ids)
 
     def _check_frames(self, frames):
         X = np.asarray(frames, dtype=np.float64)

@@ -47,14 +47,19 @@ def test_exhaustive_viterbi_matches_enumeration(model, prior, graph):
 
 
 @pytest.mark.parametrize("prior", ["graph", "layer"])
-def test_a_wide_beam_agrees_with_the_exhaustive_viterbi(model, prior):
+@pytest.mark.parametrize("guided", [False, True])
+def test_a_wide_beam_agrees_with_the_exhaustive_viterbi(model, prior, guided):
     tree, graphs, frames = model
     clip = frames[[3, 40, 75, 99, 10, 60]]
     wide = int(tree.n_nodes.max())
+    guide = None
+    if guided:  # the upper layers searched on a one-graph "global" graph
+        guide = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 100],
+                                       graph_of_clip=[0])
     for graph in (0, 1):
         for layer in range(tree.n_layers):
             paths, scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [graph], layer=layer,
-                                        n_paths=wide, node_prior=prior)
+                                        n_paths=wide, node_prior=prior, guide=guide)
             ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
                                                      node_prior=prior)
             np.testing.assert_allclose(scores[0], ex_scores)
@@ -90,14 +95,17 @@ def test_node_posteriors_are_normalised(model):
     assert np.isneginf(node_log_posterior(tree, graphs, -1, frames[:3], "graph").transpose(1, 0, 2)[:, unvisited]).all()
 
 
-def test_clips_of_different_lengths_decode_as_if_alone(model):
+@pytest.mark.parametrize("guided", [False, True])
+def test_clips_of_different_lengths_decode_as_if_alone(model, guided):
     tree, graphs, frames = model
+    guide = graphs if guided else None  # graph 0 of it guides
     offsets = np.array([0, 1, 9, 30, 33])
     clips, problems = [0, 1, 2, 3, 2, 0], [0, 1, 1, 0, 0, 1]
-    paths, scores = beam_decode(tree, graphs, frames, offsets, clips, problems, layer=-1, n_paths=3)
+    paths, scores = beam_decode(tree, graphs, frames, offsets, clips, problems, layer=-1, n_paths=3, guide=guide)
     for i, (c, g) in enumerate(zip(clips, problems)):
         clip = frames[offsets[c] : offsets[c + 1]]
-        alone_paths, alone_scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [g], layer=-1, n_paths=3)
+        alone_paths, alone_scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [g], layer=-1, n_paths=3,
+                                                guide=guide)
         np.testing.assert_allclose(scores[i], alone_scores[0])
         np.testing.assert_array_equal(paths[i][:, : len(clip)], alone_paths[0])
 
