@@ -147,15 +147,15 @@ def _trim_candidates(cand, none):
     return cand if used.all() else np.ascontiguousarray(cand[:, used])
 
 
-def _trellis(tree, graphs, layer, frames, pos, cand, graph_of_problem, allowed, pad, normalise):
-    """The candidates' trellis of one layer: ``(initial, steps)`` for :mod:`_viterbi`.
+def _emissions(tree, layer, frames, pos, cand, graph_of_problem, allowed, normalise):
+    """Log emission score of each candidate, ``(n_steps, n_candidates, n_problems)``.
 
-    ``cand`` is ``(n_steps, n_candidates, n_problems)`` node indices, ``K`` for
-    "no candidate". Without ``normalise`` the emissions are ``log Po(x | k)``:
-    the normaliser of ``Ps`` is the same for every node of a frame (within a
-    graph), so it changes no ranking and is only added at the last layer.
+    ``cand`` holds node indices, ``K`` for "no candidate" (-inf). With
+    ``normalise`` the scores are ``log Ps(k | x)``; without, ``log Po(x | k)``:
+    the normaliser is the same for every node of a frame (within a graph), so
+    it changes no ranking of sequences.
     """
-    k = graphs.n_nodes(layer)
+    k = len(tree.node_ids(layer))
     if normalise:
         log_po = np.empty((len(frames), k + 1))
         log_po[:, :k] = tree.log_likelihood(frames, layer)
@@ -164,17 +164,22 @@ def _trellis(tree, graphs, layer, frames, pos, cand, graph_of_problem, allowed, 
         norm = _log_normaliser(log_po[:, :k], allowed)
         graph_col = graph_of_problem if allowed.shape[0] > 1 else np.zeros_like(graph_of_problem)
         emit -= norm[pos, graph_col[None, :]][:, None, :]
-    else:  # only the candidates' densities: far fewer than every node on every frame
-        rows = np.broadcast_to(pos[:, None, :], cand.shape)
-        real = cand < k
-        emit = np.full(cand.shape, -np.inf)
-        emit[real] = tree.log_likelihood_pairs(frames[rows[real]], layer, cand[real])
+        return emit
+    # only the candidates' densities: far fewer than every node on every frame
+    rows = np.broadcast_to(pos[:, None, :], cand.shape)
+    real = cand < k
+    emit = np.full(cand.shape, -np.inf)
+    emit[real] = tree.log_likelihood_pairs(frames[rows[real]], layer, cand[real])
+    return emit
+
+
+def _trellis(graphs, layer, cand, emit, graph_of_problem, pad):
+    """The candidates' trellis ``(initial, steps)`` for :mod:`_viterbi`."""
     steps = graphs.log_prob(layer, graph_of_problem, cand[:-1, :, None, :], cand[1:, None, :, :])
     steps += emit[1:, None, :, :]
     # A padded step repeats the last frame: identity moves of score 0.
     t, b = np.nonzero(pad[1:])
-    identity = np.where(np.eye(cand.shape[1], dtype=bool), 0.0, -np.inf)
-    steps[t, :, :, b] = identity
+    steps[t, :, :, b] = np.where(np.eye(cand.shape[1], dtype=bool), 0.0, -np.inf)
     return emit[0], steps
 
 
@@ -217,9 +222,8 @@ def _descend(tree, graphs, frames, pos, pad, graph_of_problem, *, layer, n_paths
         if cand.shape[1] <= n_paths:
             beam = cand  # the beam keeps every candidate: nothing to score
             continue
-        initial, moves = _trellis(tree, graphs, depth, frames, pos, cand, graph_of_problem, allowed, pad,
-                                  normalise=False)
-        marginals = max_marginals(initial, moves)
+        emit = _emissions(tree, depth, frames, pos, cand, graph_of_problem, allowed, normalise=False)
+        marginals = max_marginals(*_trellis(graphs, depth, cand, emit, graph_of_problem, pad))
         keep = np.argsort(-marginals, axis=1, kind="stable")[:, :n_paths]
         beam = np.take_along_axis(cand, keep, axis=1)
         beam[np.take_along_axis(marginals, keep, axis=1) == -np.inf] = graphs.n_nodes(depth)
@@ -227,7 +231,7 @@ def _descend(tree, graphs, frames, pos, pad, graph_of_problem, *, layer, n_paths
 
 
 def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, *, layer, n_paths=5,
-                node_prior="graph", guide=None):
+                node_prior="graph", guide=None, normalise=True):
     """Top-down beam Viterbi: the best node sequences of clips under graphs, layer by layer.
 
     Every frame starts at the root. Going one layer down, a frame's candidates
@@ -297,15 +301,22 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     if guide is None:
         beam = _descend(tree, graphs, frames[used], pos, pad, graph_of_problem, layer=layer - 1,
                         n_paths=n_paths, node_prior=node_prior)
+        cand, allowed = _candidates(tree, graphs, layer, beam, graph_of_problem, node_prior)
+        emit = _emissions(tree, layer, frames[used], pos, cand, graph_of_problem, allowed, normalise)
     else:
         clips, inverse = np.unique(clip_of_problem, return_inverse=True)
         clip_pos, clip_used, clip_pad = _layout(offsets, clips)
-        beam = _descend(tree, guide, frames[clip_used], clip_pos, clip_pad, np.zeros(len(clips), dtype=np.intp),
-                        layer=layer - 1, n_paths=n_paths, node_prior=node_prior)[:, :, inverse]
-    cand, allowed = _candidates(tree, graphs, layer, beam, graph_of_problem, node_prior)
-    initial, moves = _trellis(tree, graphs, layer, frames[used], pos, cand, graph_of_problem, allowed, pad,
-                              normalise=True)
-    slots, scores = kbest_viterbi(initial, moves, n_paths)
+        first = np.zeros(len(clips), dtype=np.intp)
+        beam = _descend(tree, guide, frames[clip_used], clip_pos, clip_pad, first, layer=layer - 1,
+                        n_paths=n_paths, node_prior=node_prior)
+        if node_prior == "layer":  # the same candidates and emissions for every graph of a clip
+            cand, allowed = _candidates(tree, graphs, layer, beam, first, node_prior)
+            emit = _emissions(tree, layer, frames[clip_used], clip_pos, cand, first, allowed, normalise)
+            cand, emit = cand[:, :, inverse], emit[:, :, inverse]
+        else:
+            cand, allowed = _candidates(tree, graphs, layer, beam[:, :, inverse], graph_of_problem, node_prior)
+            emit = _emissions(tree, layer, frames[used], pos, cand, graph_of_problem, allowed, normalise)
+    slots, scores = kbest_viterbi(*_trellis(graphs, layer, cand, emit, graph_of_problem, pad), n_paths)
     nodes = cand.transpose(2, 0, 1)  # (problem, step, candidate)
     paths = np.take_along_axis(nodes[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
     paths[slots < 0] = -1

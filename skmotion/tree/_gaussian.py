@@ -190,18 +190,21 @@ class Gaussians:
         """
         X = np.asarray(X, dtype=np.float64)
         nodes = np.asarray(nodes, dtype=np.intp)
-        d = X.shape[1]
-        step = max(1, _CHUNK_ELEMENTS // (d * d if self.kind == "full" else d))
         out = np.empty(len(X))
+        if self.kind == "full":
+            # One product per distinct Gaussian: a gathered (pairs, d, d) stack would be huge.
+            order = np.argsort(nodes, kind="stable")
+            distinct, starts = np.unique(nodes[order], return_index=True)
+            for node, rows in zip(distinct, np.split(order, starts[1:])):
+                y = X[rows] @ self._prec_chol[node] - self._shifts[node]
+                out[rows] = self._const[node] - 0.5 * np.einsum("pe,pe->p", y, y)
+            return out
+        step = max(1, _CHUNK_ELEMENTS // X.shape[1])
         for start in range(0, len(X), step):
             x, k = X[start : start + step], nodes[start : start + step]
-            if self.kind == "full":
-                y = np.einsum("pd,pde->pe", x, self._prec_chol[k]) - self._shifts[k]
-                maha = np.einsum("pe,pe->p", y, y)
-            else:
-                diff = x - self.means[k]
-                prec = self._precisions[k] if self.kind == "diag" else self._precisions[k][:, None]
-                maha = np.einsum("pd,pd->p", diff * diff, np.broadcast_to(prec, diff.shape))
+            diff = x - self.means[k]
+            prec = self._precisions[k] if self.kind == "diag" else self._precisions[k][:, None]
+            maha = np.einsum("pd,pd->p", diff * diff, np.broadcast_to(prec, diff.shape))
             out[start : start + step] = self._const[k] - 0.5 * maha
         return out
 

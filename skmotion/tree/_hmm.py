@@ -274,8 +274,13 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     # -- decoding ------------------------------------------------------------------
 
-    def _decode(self, clips, graphs, layer, n_graphs):
-        """Beam-decode every clip under every graph: paths and scores per clip."""
+    def _decode(self, clips, graphs, layer, n_graphs, exact=True):
+        """Beam-decode every clip under every graph: paths and scores per clip.
+
+        Without ``exact``, and when the normaliser of ``Ps`` is the same for
+        every graph (``node_prior="layer"``), scores skip it: rankings are equal.
+        """
+        normalise = exact or self.node_prior != "layer"
         frames, offsets = stack_clips(clips)
         frames = (frames - self.center_) / self.scale_
         lengths = np.diff(offsets)
@@ -286,6 +291,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             paths, scores = beam_decode(
                 self.tree_, graphs, frames, offsets, clip_of_problem, graph_of_problem,
                 layer=layer, n_paths=self.n_paths, node_prior=self.node_prior, guide=self.global_graph_,
+                normalise=normalise,
             )
             return paths.reshape(len(chunk), n_graphs, *paths.shape[1:]), scores.reshape(len(chunk), n_graphs, -1)
 
@@ -299,13 +305,13 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
                 paths[c] = chunk_paths[i, :, :, : lengths[c]]
         return paths, scores
 
-    def _graph_log_probs(self, clips):
-        """Log generation probability of each clip under each graph, ``(n_clips, n_graphs)``."""
-        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_))
-        return logsumexp(scores, axis=2)
+    def _class_log_probs(self, clips, exact=True):
+        """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
 
-    def _class_log_probs(self, clips):
-        per_graph = self._graph_log_probs(clips)
+        Without ``exact``, up to a constant per clip (enough to rank classes).
+        """
+        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_), exact)
+        per_graph = logsumexp(scores, axis=2)
         if self.graph == "class":
             return per_graph
         out = np.full((len(clips), len(self.classes_)), -np.inf)
@@ -342,7 +348,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         proba : ndarray of shape (n_clips, n_classes)
         """
         check_is_fitted(self)
-        log_prob = self._class_log_probs(check_clips(X, estimator=self))
+        log_prob = self._class_log_probs(check_clips(X, estimator=self), exact=False)
         return np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True))
 
     def predict(self, X):
@@ -357,7 +363,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         labels : ndarray of shape (n_clips,)
         """
         check_is_fitted(self)
-        log_prob = self._class_log_probs(check_clips(X, estimator=self))
+        log_prob = self._class_log_probs(check_clips(X, estimator=self), exact=False)
         return self.classes_[np.argmax(log_prob, axis=1)]
 
     def predict_proba_windows(self, X, width, step=1):
@@ -383,7 +389,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         width, step = _check_count("width", width), _check_count("step", step)
         starts = [np.arange(0, max(len(c) - width, 0) + 1, step) for c in clips]
         windows = [c[s : s + width] for c, st in zip(clips, starts) for s in st]
-        log_prob = self._class_log_probs(windows)
+        log_prob = self._class_log_probs(windows, exact=False)
         proba = np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True))
         return np.split(proba, np.cumsum([len(s) for s in starts])[:-1])
 
@@ -406,7 +412,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
-        paths, _ = self._decode(clips, self.global_graph_, self._resolve_layer(layer), 1)
+        paths, _ = self._decode(clips, self.global_graph_, self._resolve_layer(layer), 1, exact=False)
         return [p[0, 0] for p in paths]
 
     def predict_next(self, X, n_steps=1, *, n_best=3, layer=None):
@@ -442,7 +448,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         n_steps, n_best = _check_count("n_steps", n_steps), _check_count("n_best", n_best)
         layer = self._resolve_layer(layer)
         k = self.tree_.n_nodes[layer]
-        paths, scores = self._decode(clips, self.global_graph_, layer, 1)
+        paths, scores = self._decode(clips, self.global_graph_, layer, 1, exact=False)
         weights = np.exp(scores[:, 0] - logsumexp(scores[:, 0], axis=1, keepdims=True))
         current = np.zeros((len(clips), k))
         for i, p in enumerate(paths):
