@@ -47,7 +47,7 @@ TREE_GRID = {
     "max_depth": [6, 8],
     "min_samples_leaf": [4, 16],
     "covariance_type": ["diag", "full"],
-    "smoothing": [1.0, 0.1],
+    "smoothing": [1.0, 10.0],
 }
 QUICK_TREE_GRID = {"split": ["median"], "max_depth": [6], "covariance_type": ["diag", "full"]}
 HMM_STATES = (2, 3, 4, 6)

@@ -14,6 +14,7 @@ _SUBPACKAGES = (
     "kinematics",
     "preprocessing",
     "utils",
+    "tree",
 )
 
 __all__ = ["__version__", *_SUBPACKAGES]

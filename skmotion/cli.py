@@ -14,7 +14,7 @@ def _demo(args):
 
     start = time.perf_counter()
     print(f"skmotion {__version__} demo")
-    run_demo(print, random_state=args.random_state)
+    run_demo(print, random_state=args.random_state, plot_dir=args.plots)
     print("")
     print(f"done in {time.perf_counter() - start:.1f} s")
     return 0
@@ -32,6 +32,7 @@ def build_parser():
         "demo", help="run the main job on the built-in synthetic data and print a report"
     )
     demo.add_argument("--random-state", type=int, default=0, help="seed of the data and models (default 0)")
+    demo.add_argument("--plots", metavar="DIR", default=None, help="save the sections' figures in DIR (needs matplotlib)")
     demo.set_defaults(func=_demo)
     return parser
 

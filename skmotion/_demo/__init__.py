@@ -10,10 +10,10 @@ from types import SimpleNamespace
 
 __all__ = ["SECTIONS", "run_demo"]
 
-SECTIONS = ("skmotion._demo.data",)
+SECTIONS = ("skmotion._demo.data", "skmotion._demo.recognition")
 
 
-def run_demo(write, *, random_state=0, sections=SECTIONS):
+def run_demo(write, *, random_state=0, sections=SECTIONS, plot_dir=None):
     """Run the demo sections in order, passing each line to ``write``.
 
     Parameters
@@ -24,13 +24,16 @@ def run_demo(write, *, random_state=0, sections=SECTIONS):
         Seed of the synthetic data and of every estimator.
     sections : sequence of str, default=SECTIONS
         Modules of the sections to run.
+    plot_dir : str or path-like, default=None
+        Where sections save their figures (when matplotlib is installed);
+        None draws none.
 
     Returns
     -------
     context : SimpleNamespace
         What the sections computed (the data, fitted models, scores).
     """
-    context = SimpleNamespace(random_state=random_state)
+    context = SimpleNamespace(random_state=random_state, plot_dir=plot_dir)
     for name in sections:
         module = importlib.import_module(name)
         write("")

@@ -7,9 +7,9 @@ from skmotion.tree._transitions import TransitionGraphs
 from skmotion.tree._viterbi import kbest_viterbi, max_marginals
 
 __all__ = [
-    "NODE_PRIORS",
     "MotionTree",
     "MotionTreeHMM",
+    "NODE_PRIORS",
     "TransitionGraphs",
     "beam_decode",
     "exhaustive_viterbi",

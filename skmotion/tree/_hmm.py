@@ -92,7 +92,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         95-100% for ``"layer"``, where how well a graph's nodes fit the frames
         counts too. See the user guide.
     smoothing : float, default=1.0
-        Additive (Lidstone) pseudo-count of every transition; see
+        Pseudo-transitions added to every row of every transition graph, spread
+        evenly over the layer's nodes (Lidstone smoothing); see
         :class:`TransitionGraphs`.
     n_paths : int, default=3
         The beam: nodes kept per frame at each layer of the top-down search,

@@ -2,14 +2,17 @@
 
 A graph counts the transitions ``t(m, n)`` between the nodes of consecutive
 frames of the same clip (paper section III-C). The probabilities are Lidstone
-(additive) smoothed, so an unseen transition is never ``log(0)``::
+(additive) smoothed, so an unseen transition is never ``log(0)``: ``s``
+pseudo-transitions per row (the ``smoothing``) are spread evenly over the ``K``
+nodes of the layer::
 
-    p(m -> n) = (t(m, n) + alpha) / (sum_k t(m, k) + alpha * K)
+    p(m -> n) = (t(m, n) + s / K) / (sum_k t(m, k) + s)
 
-with ``K`` the number of nodes of the layer. Every row sums to 1; a transition
-never seen has exactly the smoothing mass ``alpha / (T_m + alpha K)`` of its row
-(``T_m`` the row's count), and a node never left in the data (seen only at the
-ends of clips) has the uniform row ``1 / K``. Several graphs (one per class or
+Every row sums to 1; a transition never seen has exactly the smoothing mass
+``(s / K) / (T_m + s)`` of its row (``T_m`` the row's count), and a node never
+left in the data (seen only at the ends of clips) has the uniform row ``1 / K``.
+As ``s`` is a total per row, its weight against the data does not change with
+the number of nodes of a layer. Several graphs (one per class or
 per clip) are kept side by side: graph ``g`` of layer ``l`` is rows
 ``g K .. (g + 1) K - 1`` of one sparse count matrix.
 """
@@ -39,7 +42,7 @@ class TransitionGraphs:
     visits : list of ndarray of shape (n_graphs, K_l)
         Per layer, how many frames of each graph's clips fall in each node.
     smoothing : float
-        The additive smoothing ``alpha`` (> 0).
+        Pseudo-transitions per row, ``s`` (> 0).
 
     Attributes
     ----------
@@ -55,7 +58,7 @@ class TransitionGraphs:
     >>> g = TransitionGraphs.count(labels, [2], offsets=[0, 5], graph_of_clip=[0], smoothing=1.0)
     >>> g.counts(0, 0).toarray().tolist()
     [[1, 1], [1, 1]]
-    >>> g.matrix(0, 0).tolist()                        # (1 + 1) / (2 + 2)
+    >>> g.matrix(0, 0).tolist()                        # (1 + 1 / 2) / (2 + 1)
     [[0.5, 0.5], [0.5, 0.5]]
     """
 
@@ -90,7 +93,7 @@ class TransitionGraphs:
         n_graphs : int, default=None
             Number of graphs; ``max(graph_of_clip) + 1`` by default.
         smoothing : float, default=1.0
-            The additive smoothing ``alpha``.
+            Pseudo-transitions per row, spread evenly over the nodes.
 
         Returns
         -------
@@ -122,9 +125,9 @@ class TransitionGraphs:
             return None
         table = np.zeros((self.n_graphs, k + 1, k + 1))
         table[:, :k, :k] = self._counts[layer].toarray().reshape(self.n_graphs, k, k)
-        table += self.smoothing
+        table += self.pseudo_count(layer)
         with np.errstate(divide="ignore"):
-            table[:, :k, :k] /= (self._totals[layer] + self.smoothing * k)[:, :, None]
+            table[:, :k, :k] /= (self._totals[layer] + self.smoothing)[:, :, None]
             table = np.log(table)
         table[:, k, :] = -np.inf
         table[:, :, k] = -np.inf
@@ -155,9 +158,13 @@ class TransitionGraphs:
         """Frames of each graph's clips in each node, ``(n_graphs, K)``."""
         return self._visits[layer]
 
+    def pseudo_count(self, layer):
+        """The pseudo-count added to every transition of a layer, ``smoothing / K``."""
+        return self.smoothing / self.n_nodes(layer)
+
     def unseen_probability(self, layer):
         """The probability of a never-seen transition in each row, ``(n_graphs, K)``."""
-        return self.smoothing / (self._totals[layer] + self.smoothing * self.n_nodes(layer))
+        return self.pseudo_count(layer) / (self._totals[layer] + self.smoothing)
 
     def log_prob(self, layer, graph, src, dst):
         """``log p(src -> dst)`` in a graph, for broadcastable index arrays.
@@ -188,20 +195,20 @@ class TransitionGraphs:
             t = np.where(keys[pos] == flat, data[pos], 0)
         totals = np.append(self._totals[layer], np.zeros((self.n_graphs, 1)), axis=1).ravel()
         with np.errstate(divide="ignore"):
-            out = np.log((t + self.smoothing) / (totals.take(row) + self.smoothing * k))
+            out = np.log((t + self.pseudo_count(layer)) / (totals.take(row) + self.smoothing))
         out[np.broadcast_to((src == k) | (dst == k), out.shape)] = -np.inf
         return out
 
     def matrix(self, layer, graph):
         """The dense ``(K, K)`` transition probabilities of one graph (small layers)."""
         k = self.n_nodes(layer)
-        table = self.counts(layer, graph).toarray().astype(np.float64) + self.smoothing
-        return table / (self._totals[layer][graph] + self.smoothing * k)[:, None]
+        table = self.counts(layer, graph).toarray().astype(np.float64) + self.pseudo_count(layer)
+        return table / (self._totals[layer][graph] + self.smoothing)[:, None]
 
     def propagate(self, layer, graph, distribution, n_steps=1):
         """A node distribution after ``n_steps`` transitions: ``distribution @ P ** n_steps``.
 
-        Uses the sparse counts: ``P = diag(1 / (T + alpha K)) C + u 1^T`` with
+        Uses the sparse counts: ``P = diag(1 / (T + s)) C + u 1^T`` with
         ``u`` the unseen probability of each row, so no dense ``K x K`` matrix is formed.
 
         Parameters
@@ -217,8 +224,8 @@ class TransitionGraphs:
         """
         k = self.n_nodes(layer)
         counts = self.counts(layer, graph)
-        scale = 1.0 / (self._totals[layer][graph] + self.smoothing * k)
-        unseen = self.smoothing * scale
+        scale = 1.0 / (self._totals[layer][graph] + self.smoothing)
+        unseen = self.pseudo_count(layer) * scale
         out = np.asarray(distribution, dtype=np.float64)
         for _ in range(n_steps):
             out = np.asarray((counts.T @ (out * scale).T).T) + (out @ unseen)[..., None]

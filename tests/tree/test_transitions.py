@@ -42,9 +42,10 @@ def test_counts_and_probabilities(case, alpha):
         totals = expected[g].sum(axis=1, keepdims=True)
         unseen = expected[g] == 0
         # never-seen transitions hold exactly the smoothing mass of their row
-        np.testing.assert_array_equal(P[unseen], np.broadcast_to(alpha / (totals + alpha * k), P.shape)[unseen])
-        np.testing.assert_allclose(P[~unseen], ((expected[g] + alpha) / (totals + alpha * k))[~unseen])
-        np.testing.assert_allclose(graphs.unseen_probability(0)[g], alpha / (totals[:, 0] + alpha * k))
+        mass = (alpha / k) / (totals + alpha)
+        np.testing.assert_array_equal(P[unseen], np.broadcast_to(mass, P.shape)[unseen])
+        np.testing.assert_allclose(P[~unseen], ((expected[g] + alpha / k) / (totals + alpha))[~unseen])
+        np.testing.assert_allclose(graphs.unseen_probability(0)[g], mass[:, 0])
         nodes = np.arange(k)
         np.testing.assert_allclose(np.exp(graphs.log_prob(0, g, nodes[:, None], nodes[None])), P)
     visits = np.zeros((n_graphs, k), dtype=int)
