@@ -44,7 +44,7 @@ from skmotion.tree import MotionTree, MotionTreeHMM  # noqa: E402
 TREE_GRID = {
     "n_paths": [1, 3],
     "split": ["min_error", "median", "two_means"],
-    "max_depth": [6, 8],
+    "max_depth": [6, 7, 8],
     "min_samples_leaf": [4, 16],
     "covariance_type": ["diag", "full"],
     "smoothing": [1.0, 10.0],

@@ -282,6 +282,10 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         every graph (``node_prior="layer"``), scores skip it: rankings are equal.
         """
         normalise = exact or self.node_prior != "layer"
+        # One beam search per clip on the global graph, shared by all graphs. Under
+        # node_prior="graph" a graph may have no candidate left in the shared beam,
+        # so each graph then searches on its own.
+        guide = self.global_graph_ if self.node_prior == "layer" else None
         frames, offsets = stack_clips(clips)
         frames = (frames - self.center_) / self.scale_
         lengths = np.diff(offsets)
@@ -291,8 +295,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             graph_of_problem = np.tile(np.arange(n_graphs), len(chunk))
             paths, scores = beam_decode(
                 self.tree_, graphs, frames, offsets, clip_of_problem, graph_of_problem,
-                layer=layer, n_paths=self.n_paths, node_prior=self.node_prior, guide=self.global_graph_,
-                normalise=normalise,
+                layer=layer, n_paths=self.n_paths, node_prior=self.node_prior, guide=guide, normalise=normalise,
             )
             return paths.reshape(len(chunk), n_graphs, *paths.shape[1:]), scores.reshape(len(chunk), n_graphs, -1)
 

@@ -119,6 +119,15 @@ def test_classifying_at_an_upper_layer(motions):
         MotionTreeHMM(max_depth=3, layer=20).fit(X, y)
 
 
+@pytest.mark.parametrize("graph", ["class", "clip"])
+def test_the_papers_node_prior_gives_finite_answers(motions, graph):
+    X, y, _ = motions
+    model = MotionTreeHMM(max_depth=5, node_prior="graph", graph=graph).fit(X[::2], y[::2])
+    proba = model.predict_proba(X[1::4])
+    assert np.isfinite(proba).all() and np.allclose(proba.sum(axis=1), 1.0)
+    assert np.isfinite(model.score_samples(X[1::4])).all()
+
+
 def test_hard_cases_give_finite_answers():
     rng = np.random.default_rng(0)
     X = [rng.normal(size=(n, 12)) for n in (40, 35, 50, 1, 2)]
