@@ -10,43 +10,21 @@ from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, column_or_1d
 
 from skmotion.base import ClipEstimatorMixin
-from skmotion.tree._decode import NODE_PRIORS, beam_decode
+from skmotion.tree._batch import decode_clips
+from skmotion.tree._decode import NODE_PRIORS
 from skmotion.tree._gaussian import COVARIANCE_TYPES
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._split import SPLIT_CRITERIA
 from skmotion.tree._transitions import TransitionGraphs
 from skmotion.utils._clips import check_clips, stack_clips
-from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["MotionTreeHMM"]
-
-# Clips are decoded in groups of at most this many (step, graph) pairs, counting
-# the padding of shorter clips to the longest of the group. Groups depend on the
-# data only, so results are the same for any n_jobs.
-_CHUNK_PAIRS = 1 << 17
-
 
 def _check_count(name, value, low=1):
     if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
         raise ValueError(f"{name} must be an int >= {low}; got {value!r}.")
     return int(value)
-
-
-def _chunks(lengths, n_graphs):
-    """Groups of clips of similar lengths, so little padding is decoded.
-
-    Clips are taken shortest first; a group grows while (its longest clip) x
-    (its clips) x ``n_graphs`` stays within ``_CHUNK_PAIRS``.
-    """
-    order = np.argsort(lengths, kind="stable")
-    groups, start = [], 0
-    for end in range(1, len(order) + 1):
-        if end - start > 1 and lengths[order[end - 1]] * (end - start) * n_graphs > _CHUNK_PAIRS:
-            groups.append(order[start : end - 1])
-            start = end - 1
-    groups.append(order[start:])
-    return groups
 
 
 class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -287,27 +265,10 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         # so each graph then searches on its own.
         guide = self.global_graph_ if self.node_prior == "layer" else None
         frames, offsets = stack_clips(clips)
-        frames = (frames - self.center_) / self.scale_
-        lengths = np.diff(offsets)
-
-        def work(chunk):
-            clip_of_problem = np.repeat(chunk, n_graphs)
-            graph_of_problem = np.tile(np.arange(n_graphs), len(chunk))
-            paths, scores = beam_decode(
-                self.tree_, graphs, frames, offsets, clip_of_problem, graph_of_problem,
-                layer=layer, n_paths=self.n_paths, node_prior=self.node_prior, guide=guide, normalise=normalise,
-            )
-            return paths.reshape(len(chunk), n_graphs, *paths.shape[1:]), scores.reshape(len(chunk), n_graphs, -1)
-
-        chunks = _chunks(lengths, n_graphs)
-        results = parallel_map(work, chunks, n_jobs=self.n_jobs)
-        paths = [None] * len(clips)
-        scores = np.empty((len(clips), n_graphs, self.n_paths))
-        for (chunk_paths, chunk_scores), chunk in zip(results, chunks):
-            scores[chunk] = chunk_scores
-            for i, c in enumerate(chunk):
-                paths[c] = chunk_paths[i, :, :, : lengths[c]]
-        return paths, scores
+        return decode_clips(
+            self.tree_, graphs, (frames - self.center_) / self.scale_, offsets, n_graphs=n_graphs, layer=layer,
+            n_paths=self.n_paths, node_prior=self.node_prior, guide=guide, normalise=normalise, n_jobs=self.n_jobs,
+        )
 
     def _class_log_probs(self, clips, exact=True):
         """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
