@@ -125,9 +125,18 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     -----
     ``Ps(k | x) = Po(x | k) / sum_j Po(x | j)`` with ``j`` over the nodes of the
     prior; everything is computed in log space, so clips of any length give
-    finite scores. Building costs O(N log N) for N frames; decoding a clip of
-    M frames costs ``O(M n_paths^2)`` per layer and graph, plus the Gaussian of
-    every node of each layer on every frame for the normaliser.
+    finite scores. Building costs O(N log N) for N frames when the tree is
+    about ``log N`` deep.
+
+    With ``node_prior="layer"`` the layers above ``layer_`` are searched once
+    per clip on the global graph, and each class's (or clip's) graph runs the
+    last K-best pass on the candidates that leaves; this shared beam gave the
+    same accuracy as one search per graph in our measurements, for a fraction
+    of the work. The normaliser of ``Ps`` is then the same for every graph, so
+    ``predict``, ``predict_proba`` and ``decode`` skip it; ``score_samples``
+    computes it (every node's density on every frame). Decoding a clip of M
+    frames costs ``O(M n_paths^2)`` per layer. See the user guide
+    (``docs/motion-database.md``) for the measurements behind these choices.
 
     References
     ----------
