@@ -6,31 +6,15 @@ step ``t``, the log score of moving from state ``i`` at ``t - 1`` to state ``j``
 at ``t`` *including* the score of ``j`` itself (``steps[t - 1, i, j]``). A
 sequence's score is the sum of its terms.
 
-Arrays are time-major with the problems on the *last* axis: every operation
-works on contiguous slabs of all problems at once, and maxima over the few
-states are taken slab by slab (numpy's reductions over a short axis are many
-times slower). The recursion runs step after step, as it must.
+Arrays are time-major with the problems on the *last* axis, so every operation
+runs over contiguous rows of all problems at once (numpy reduces a short axis
+many times faster when it is not the innermost one). The recursion runs step
+after step, as it must.
 """
 
 import numpy as np
 
 __all__ = ["kbest_viterbi", "max_marginals"]
-
-
-def _max_first(values, out):
-    """``values.max(axis=0)`` for a short first axis, slab by slab, into ``out``."""
-    np.copyto(out, values[0])
-    for i in range(1, len(values)):
-        np.maximum(out, values[i], out=out)
-    return out
-
-
-def _max_second(values, out):
-    """``values.max(axis=1)`` for a short second axis, slab by slab, into ``out``."""
-    np.copyto(out, values[:, 0])
-    for i in range(1, values.shape[1]):
-        np.maximum(out, values[:, i], out=out)
-    return out
 
 
 def max_marginals(initial, steps):
@@ -62,10 +46,10 @@ def max_marginals(initial, steps):
     forward = np.empty((n_steps,) + initial.shape)
     forward[0] = initial
     for t in range(1, n_steps):
-        _max_first(forward[t - 1][:, None, :] + steps[t - 1], forward[t])
+        np.max(forward[t - 1][:, None, :] + steps[t - 1], axis=0, out=forward[t])
     backward = np.zeros_like(forward)
     for t in range(n_steps - 2, -1, -1):
-        _max_second(steps[t] + backward[t + 1][None, :, :], backward[t])
+        np.max(steps[t] + backward[t + 1][None, :, :], axis=1, out=backward[t])
     forward += backward
     return forward
 
