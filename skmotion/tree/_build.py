@@ -11,6 +11,7 @@ pairwise distances and no Python loop over frames (only over nodes).
 
 import numpy as np
 from scipy.linalg import eigh
+from scipy.linalg.lapack import dsyevr
 
 from skmotion.tree._gaussian import estimate_covariance
 from skmotion.tree._split import best_split
@@ -21,16 +22,20 @@ __all__ = ["build_nodes"]
 # rounding error, so routing a training frame again always finds the same side.
 _GAP_RESOLUTION = 1e-12
 
-def _top_eigenvectors(symmetric, k):
-    """The ``k`` leading eigenpairs, largest first.
 
-    LAPACK's subset driver is used: only the wanted pairs are computed, which is
-    much faster than a full decomposition for the small matrices of tree nodes.
+def _top_eigenvectors(symmetric, k):
+    """The ``k`` leading eigenpairs of a symmetric matrix, largest first.
+
+    LAPACK's subset driver computes only the wanted pairs; it is called
+    directly because the wrapper's checks cost as much as the work on the small
+    matrices of tree nodes.
     """
     m = len(symmetric)
     k = min(k, m)
-    values, vectors = eigh(symmetric, subset_by_index=[m - k, m - 1], driver="evr", check_finite=False)
-    return values[::-1], vectors[:, ::-1]
+    values, vectors, _, _, info = dsyevr(symmetric, compute_v=1, range="I", il=m - k + 1, iu=m)
+    if info != 0:  # pragma: no cover - LAPACK failure on a finite symmetric matrix
+        values, vectors = eigh(symmetric, subset_by_index=[m - k, m - 1])
+    return values[:k][::-1], vectors[:, :k][:, ::-1]
 
 
 def _fix_signs(axes):
@@ -47,10 +52,11 @@ def _principal_axis(centred, scatter):
     else:  # fewer frames than channels: the small n x n problem has the same axis
         values, vectors = _top_eigenvectors(centred @ centred.T, 1)
         axis = centred.T @ vectors[:, 0]
-    norm = np.linalg.norm(axis)
+    norm = float(np.sqrt(axis @ axis))
     if values[0] <= 0.0 or norm == 0.0:
         return None
-    return _fix_signs((axis / norm)[None])[0]
+    axis = axis / norm
+    return -axis if axis[np.argmax(np.abs(axis))] < 0 else axis
 
 
 class _Builder:
