@@ -13,7 +13,7 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.linalg.lapack import dsyevr
 
-from skmotion.tree._gaussian import estimate_covariance
+from skmotion.tree._gaussian import centred_moments, estimate_covariance
 from skmotion.tree._split import best_split
 
 __all__ = ["build_nodes"]
@@ -45,11 +45,15 @@ def _fix_signs(axes):
 
 
 def _principal_axis(centred, scatter):
-    """The unit first principal axis of centred frames (None when they do not vary)."""
-    if scatter is not None:
+    """The unit first principal axis of a node (None when its frames do not vary).
+
+    With fewer frames than channels, ``centred`` (the frames minus their mean)
+    is given and the smaller ``n x n`` problem, which has the same axis, is solved.
+    """
+    if centred is None:
         values, vectors = _top_eigenvectors(scatter, 1)
         axis = vectors[:, 0]
-    else:  # fewer frames than channels: the small n x n problem has the same axis
+    else:
         values, vectors = _top_eigenvectors(centred @ centred.T, 1)
         axis = centred.T @ vectors[:, 0]
     norm = float(np.sqrt(axis @ axis))
@@ -63,17 +67,19 @@ class _Builder:
     """Breadth-first construction on a copy of the frames in which every node's
     frames are one contiguous block (splitting a node reorders its block)."""
 
-    def __init__(self, X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg):
+    def __init__(self, X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar):
         # Rounding of a projection x @ axis is below d * eps * max|x|; cuts must
         # sit in gaps far wider, so a training frame always routes back to its side.
-        self.tol = _GAP_RESOLUTION * X.shape[1] * float(np.abs(X).max())
+        self.tol = _GAP_RESOLUTION * X.shape[1] * max(float(X.max()), -float(X.min()))
         self.blocks = X.copy()
+        self.reg_covar = reg_covar
+        self.reg = None  # set from the root's variance
+        self.root_scatter = None
         self.max_depth = max_depth
         self.min_split = max(min_samples_split, 2 * min_samples_leaf, 2)
         self.min_leaf = min_samples_leaf
         self.split = split
         self.kind = covariance_type
-        self.reg = reg
         self.nodes = {k: [] for k in ("parent", "depth", "start", "stop", "mean", "cov", "axis", "thr", "left", "right")}
 
     def add(self, parent, depth, start, stop):
@@ -89,19 +95,19 @@ class _Builder:
         start, stop = nodes["start"][node], nodes["stop"][node]
         block = self.blocks[start:stop]
         n, d = block.shape
-        mean = block.mean(axis=0)
-        centred = block - mean
-        eligible = may_split and n >= self.min_split
-        scatter = centred.T @ centred if (self.kind == "full" or (eligible and n >= d)) else None
+        mean, scatter, sq_norms = centred_moments(block)
+        if self.reg is None:  # the root: reg_covar is relative to its mean per-channel variance
+            scale = np.trace(scatter) / (n * d)
+            self.reg = self.reg_covar * scale if scale > 0 else float(self.reg_covar)
+            self.root_scatter = scatter
         nodes["mean"][node] = mean
-        nodes["cov"][node] = estimate_covariance(centred, self.kind, self.reg, scatter)
-        if not eligible:
+        nodes["cov"][node] = estimate_covariance(scatter, sq_norms, self.kind, self.reg)
+        if not (may_split and n >= self.min_split):
             return ()
-        axis = _principal_axis(centred, scatter if n >= d else None)
+        axis = _principal_axis(block - mean if n < d else None, scatter)
         if axis is None:
             return ()
-        proj = centred @ axis
-        proj += mean @ axis  # the projection of the frames themselves, as routing computes it
+        proj = block @ axis  # as routing computes it
         order = np.argsort(proj, kind="stable")
         ordered = proj[order]
         n_left = best_split(ordered, self.split, min_samples_leaf=self.min_leaf, tol=self.tol)
@@ -137,14 +143,7 @@ class _Builder:
         return layers
 
 
-def _root_axes(X, n_axes=3):
-    """The first principal axes of all frames (for plotting node positions)."""
-    centred = X - X.mean(axis=0)
-    _, vectors = _top_eigenvectors(centred.T @ centred, n_axes)
-    return _fix_signs(vectors.T)
-
-
-def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg):
+def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar):
     """Grow the tree over validated frames; the per-node arrays and the layers.
 
     Parameters
@@ -153,17 +152,19 @@ def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, cov
         C-contiguous, finite frames.
     max_depth, min_samples_split, min_samples_leaf, split, covariance_type
         As for :meth:`MotionTree.build`.
-    reg : float
-        The absolute variance added to every covariance's diagonal.
+    reg_covar : float
+        Added to every variance, as a fraction of the mean per-channel variance
+        of all frames (absolute when the frames do not vary).
 
     Returns
     -------
     nodes : dict
         ``parent``, ``left``, ``right``, ``depth``, ``count``, ``mean``,
-        ``covariance``, ``axis``, ``threshold`` (per tree node id), ``layers``
-        and ``principal_axes``: the arguments of ``MotionTree``.
+        ``covariance``, ``axis``, ``threshold`` (per tree node id), ``layers``,
+        ``principal_axes`` (the first three axes of all frames) and ``reg`` (the
+        absolute regularisation): the arguments of ``MotionTree``.
     """
-    builder = _Builder(X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg)
+    builder = _Builder(X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar)
     layers = builder.run()
     nodes = builder.nodes
     d = X.shape[1]
@@ -178,5 +179,6 @@ def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, cov
         "axis": np.array([np.zeros(d) if a is None else a for a in nodes["axis"]]),
         "threshold": np.array(nodes["thr"], dtype=np.float64),
         "layers": layers,
-        "principal_axes": _root_axes(X),
+        "principal_axes": _fix_signs(_top_eigenvectors(builder.root_scatter, 3)[1].T),
+        "reg": builder.reg,
     }

@@ -13,7 +13,7 @@ change; its covariance must still be invertible. Three estimators are offered:
 import numpy as np
 from scipy.linalg import solve_triangular
 
-__all__ = ["COVARIANCE_TYPES", "Gaussians", "estimate_covariance", "ledoit_wolf_shrinkage"]
+__all__ = ["COVARIANCE_TYPES", "Gaussians", "centred_moments", "estimate_covariance", "ledoit_wolf_shrinkage"]
 
 #: The covariance estimators of :func:`estimate_covariance`.
 COVARIANCE_TYPES = ("diag", "full", "spherical")
@@ -23,15 +23,52 @@ _LOG_2PI = np.log(2.0 * np.pi)
 _CHUNK_ELEMENTS = 1 << 22
 
 
-def ledoit_wolf_shrinkage(centred, scatter):
+def centred_moments(frames, chunk_rows=None):
+    """Mean, scatter ``sum (x - m)(x - m)^T`` and squared norms ``|x - m|^2`` of frames.
+
+    Computed in row chunks, so no centred copy of a large node is ever made.
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, n_channels)
+    chunk_rows : int, default=None
+        Rows per chunk; by default about four million values a chunk.
+
+    Returns
+    -------
+    mean : ndarray of shape (n_channels,)
+    scatter : ndarray of shape (n_channels, n_channels)
+    sq_norms : ndarray of shape (n_frames,)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree._gaussian import centred_moments
+    >>> mean, scatter, sq_norms = centred_moments(np.array([[0.0, 1.0], [2.0, 1.0]]))
+    >>> mean.tolist(), scatter.tolist(), sq_norms.tolist()
+    ([1.0, 1.0], [[2.0, 0.0], [0.0, 0.0]], [1.0, 1.0])
+    """
+    n, d = frames.shape
+    step = chunk_rows or max(1, _CHUNK_ELEMENTS // d)
+    mean = frames.mean(axis=0)
+    scatter = np.zeros((d, d))
+    sq_norms = np.empty(n)
+    for start in range(0, n, step):
+        centred = frames[start : start + step] - mean
+        scatter += centred.T @ centred
+        sq_norms[start : start + step] = np.einsum("ij,ij->i", centred, centred)
+    return mean, scatter, sq_norms
+
+
+def ledoit_wolf_shrinkage(scatter, sq_norms):
     """Ledoit and Wolf's optimal shrinkage of a sample covariance to a scaled identity.
 
     Parameters
     ----------
-    centred : ndarray of shape (n_frames, n_channels)
-        Frames minus their mean.
     scatter : ndarray of shape (n_channels, n_channels)
-        ``centred.T @ centred``.
+        ``sum (x - m)(x - m)^T`` over the frames.
+    sq_norms : ndarray of shape (n_frames,)
+        ``|x - m|^2`` of each frame.
 
     Returns
     -------
@@ -42,14 +79,12 @@ def ledoit_wolf_shrinkage(centred, scatter):
     Examples
     --------
     >>> import numpy as np
-    >>> from skmotion.tree._gaussian import ledoit_wolf_shrinkage
-    >>> X = np.random.default_rng(0).normal(size=(5, 20))
-    >>> X -= X.mean(0)
-    >>> 0 < ledoit_wolf_shrinkage(X, X.T @ X) <= 1
+    >>> from skmotion.tree._gaussian import centred_moments, ledoit_wolf_shrinkage
+    >>> _, scatter, sq_norms = centred_moments(np.random.default_rng(0).normal(size=(5, 20)))
+    >>> 0 < ledoit_wolf_shrinkage(scatter, sq_norms) <= 1
     True
     """
-    n, d = centred.shape
-    sq_norms = np.einsum("ij,ij->i", centred, centred)
+    n, d = len(sq_norms), len(scatter)
     trace = sq_norms.sum() / n
     mu = trace / d
     frob = np.sum(scatter * scatter) / (n * n)  # ||S||_F^2
@@ -59,19 +94,17 @@ def ledoit_wolf_shrinkage(centred, scatter):
     return 1.0 if delta <= 0 else float(beta / delta)
 
 
-def estimate_covariance(centred, kind, reg, scatter=None):
+def estimate_covariance(scatter, sq_norms, kind, reg):
     """The covariance of one node's frames, by the chosen estimator.
 
     Parameters
     ----------
-    centred : ndarray of shape (n_frames, n_channels)
-        The node's frames minus their mean.
+    scatter, sq_norms : ndarray
+        The node's centred moments (see :func:`centred_moments`).
     kind : {"diag", "full", "spherical"}
         The estimator (see the module's description).
     reg : float
         Added to every variance (the diagonal), so no covariance is singular.
-    scatter : ndarray of shape (n_channels, n_channels), default=None
-        ``centred.T @ centred`` when already computed.
 
     Returns
     -------
@@ -81,23 +114,20 @@ def estimate_covariance(centred, kind, reg, scatter=None):
     Examples
     --------
     >>> import numpy as np
-    >>> from skmotion.tree._gaussian import estimate_covariance
-    >>> X = np.array([[0.0, 1.0], [2.0, 1.0]])
-    >>> estimate_covariance(X - X.mean(0), "diag", 0.5).tolist()
+    >>> from skmotion.tree._gaussian import centred_moments, estimate_covariance
+    >>> _, scatter, sq_norms = centred_moments(np.array([[0.0, 1.0], [2.0, 1.0]]))
+    >>> estimate_covariance(scatter, sq_norms, "diag", 0.5).tolist()
     [1.5, 0.5]
     """
-    n = len(centred)
+    n, d = len(sq_norms), len(scatter)
     if kind == "diag":
-        squares = np.diag(scatter) if scatter is not None else np.einsum("ij,ij->j", centred, centred)
-        return squares / n + reg
+        return np.diag(scatter) / n + reg
     if kind == "spherical":
-        return float(np.einsum("ij,ij->", centred, centred) / centred.size + reg)
+        return float(np.trace(scatter) / (n * d) + reg)
     if kind == "full":
-        if scatter is None:
-            scatter = centred.T @ centred
         sample = scatter / n
-        shrink = ledoit_wolf_shrinkage(centred, scatter)
-        mu = np.trace(sample) / sample.shape[0]
+        shrink = ledoit_wolf_shrinkage(scatter, sq_norms)
+        mu = np.trace(sample) / d
         covariance = (1.0 - shrink) * sample
         covariance[np.diag_indices_from(covariance)] += shrink * mu + reg
         return covariance

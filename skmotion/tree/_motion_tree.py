@@ -143,12 +143,10 @@ class MotionTree:
             raise ValueError(f"covariance_type must be one of {COVARIANCE_TYPES}; got {covariance_type!r}.")
         if not isinstance(reg_covar, Real) or not reg_covar > 0:
             raise ValueError(f"reg_covar must be a positive number; got {reg_covar!r}.")
-        X = np.ascontiguousarray(X)
-        scale = float(X.var(axis=0).mean())
-        reg = reg_covar * scale if scale > 0 else float(reg_covar)
-        nodes = build_nodes(X, max_depth=max_depth, min_samples_split=min_samples_split,
-                            min_samples_leaf=min_samples_leaf, split=split, covariance_type=covariance_type, reg=reg)
-        return cls(**nodes, covariance_type=covariance_type, reg=reg)
+        nodes = build_nodes(np.ascontiguousarray(X), max_depth=max_depth, min_samples_split=min_samples_split,
+                            min_samples_leaf=min_samples_leaf, split=split, covariance_type=covariance_type,
+                            reg_covar=reg_covar)
+        return cls(**nodes, covariance_type=covariance_type)
 
     # -- sizes and layer structure ------------------------------------------------
 

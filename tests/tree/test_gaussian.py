@@ -5,30 +5,42 @@ import pytest
 from scipy.stats import multivariate_normal
 from sklearn.covariance import ledoit_wolf, ledoit_wolf_shrinkage as sk_shrinkage
 
-from skmotion.tree._gaussian import Gaussians, estimate_covariance, ledoit_wolf_shrinkage
+from skmotion.tree._gaussian import Gaussians, centred_moments, estimate_covariance, ledoit_wolf_shrinkage
+
+
+@pytest.mark.parametrize("chunk_rows", [None, 7])
+def test_centred_moments_in_chunks(chunk_rows):
+    X = np.random.default_rng(0).normal(size=(40, 5)) + 100.0
+    mean, scatter, sq_norms = centred_moments(X, chunk_rows=chunk_rows)
+    centred = X - X.mean(0)
+    np.testing.assert_allclose(mean, X.mean(0))
+    np.testing.assert_allclose(scatter, centred.T @ centred, rtol=1e-10)
+    np.testing.assert_allclose(sq_norms, (centred**2).sum(1), rtol=1e-10)
 
 
 @pytest.mark.parametrize("n, d", [(50, 4), (5, 20), (2, 3), (200, 60)])
 def test_ledoit_wolf_matches_sklearn(n, d):
     X = np.random.default_rng(n).normal(size=(n, d)) @ np.diag(np.linspace(0.1, 3, d))
+    _, scatter, sq_norms = centred_moments(X)
     Xc = X - X.mean(0)
-    assert ledoit_wolf_shrinkage(Xc, Xc.T @ Xc) == pytest.approx(sk_shrinkage(Xc, assume_centered=True))
+    assert ledoit_wolf_shrinkage(scatter, sq_norms) == pytest.approx(sk_shrinkage(Xc, assume_centered=True))
     expected, _ = ledoit_wolf(Xc, assume_centered=True)
-    np.testing.assert_allclose(estimate_covariance(Xc, "full", 0.0), expected, atol=1e-12)
+    np.testing.assert_allclose(estimate_covariance(scatter, sq_norms, "full", 0.0), expected, atol=1e-12)
 
 
 def test_diag_and_spherical_add_the_regularisation():
     X = np.array([[0.0, 1.0, 5.0], [2.0, 1.0, 5.0], [4.0, 1.0, 5.0]])
-    Xc = X - X.mean(0)
-    np.testing.assert_allclose(estimate_covariance(Xc, "diag", 0.1), [8 / 3 + 0.1, 0.1, 0.1])
-    assert estimate_covariance(Xc, "spherical", 0.1) == pytest.approx(8 / 9 + 0.1)
+    _, scatter, sq_norms = centred_moments(X)
+    np.testing.assert_allclose(estimate_covariance(scatter, sq_norms, "diag", 0.1), [8 / 3 + 0.1, 0.1, 0.1])
+    assert estimate_covariance(scatter, sq_norms, "spherical", 0.1) == pytest.approx(8 / 9 + 0.1)
 
 
 def test_fewer_frames_than_channels_stay_positive_definite():
     X = np.random.default_rng(0).normal(size=(3, 30))
     X[:, 5] = 7.0  # a constant channel
+    _, scatter, sq_norms = centred_moments(X)
     for kind in ("full", "diag", "spherical"):
-        cov = np.atleast_1d(estimate_covariance(X - X.mean(0), kind, 1e-6))
+        cov = np.atleast_1d(estimate_covariance(scatter, sq_norms, kind, 1e-6))
         eig = np.linalg.eigvalsh(cov) if cov.ndim == 2 else cov
         assert eig.min() > 0
 
@@ -57,7 +69,7 @@ def test_log_pdf_matches_scipy(kind):
 
 def test_unknown_kind():
     with pytest.raises(ValueError, match="covariance_type must be one of"):
-        estimate_covariance(np.zeros((2, 2)), "tied", 0.0)
+        estimate_covariance(np.zeros((2, 2)), np.zeros(2), "tied", 0.0)
 
 
 @pytest.mark.parametrize("kind", ["full", "diag", "spherical"])
