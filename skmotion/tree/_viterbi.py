@@ -74,11 +74,13 @@ def _top_ranks(scores, n_paths, n_lists):
     shape = scores.shape[1:]
     order = np.zeros((n_paths,) + shape, dtype=np.intp)
     best = np.empty((n_paths,) + shape)
+    better = np.empty(shape, dtype=bool)
     for r in range(n_paths):
         top, pick = best[r], order[r]
         np.copyto(top, scores[0])
         for i in range(1, min((r + 1) * n_lists, len(scores))):
-            np.copyto(pick, i, where=scores[i] > top)
+            np.greater(scores[i], top, out=better)
+            np.copyto(pick, i, where=better)
             np.maximum(top, scores[i], out=top)
         if r + 1 < n_paths:
             np.put_along_axis(scores, pick[None], -np.inf, axis=0)
