@@ -123,3 +123,13 @@ def test_ten_thousand_frames_keep_finite_probabilities(model):
     paths, scores = beam_decode(tree, graphs, clip, [0, 10_000], [0], [0], layer=-1, n_paths=2)
     assert np.isfinite(scores).all() and scores[0, 0] < -1000  # far below the smallest double
     assert (paths[0] >= 0).all()
+
+
+def test_the_normaliser_survives_underflow():
+    from skmotion.tree._decode import _log_normaliser
+
+    log_po = np.array([[0.0, -2000.0, -2001.0], [-5.0, -6.0, -7.0]])
+    allowed = np.array([[True, True, True], [False, True, True]])
+    expected = [[logsumexp(log_po[i][allowed[g]]) for g in range(2)] for i in range(2)]
+    np.testing.assert_allclose(_log_normaliser(log_po, allowed), expected)
+    assert np.isfinite(_log_normaliser(log_po, allowed)).all()
