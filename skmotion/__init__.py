@@ -19,6 +19,7 @@ _SUBPACKAGES = (
     "plotting",
     "preprocessing",
     "utils",
+    "tree",
 )
 
 __all__ = ["__version__", *_SUBPACKAGES]

@@ -19,7 +19,7 @@ def _demo(args):
     if args.data is not None:
         sections = tuple("skmotion._demo.data_folder" if s == "skmotion._demo.data" else s for s in SECTIONS)
         options = {"data_folder": args.data, "frame_rate": args.frame_rate}
-    run_demo(print, random_state=args.random_state, sections=sections, **options)
+    run_demo(print, random_state=args.random_state, sections=sections, plot_dir=args.plots, **options)
     print("")
     print(f"done in {time.perf_counter() - start:.1f} s")
     return 0
@@ -57,6 +57,7 @@ def build_parser():
     demo.add_argument(
         "--frame-rate", type=float, default=30.0, help="with --data: resample every clip to this rate (default 30 Hz)"
     )
+    demo.add_argument("--plots", metavar="DIR", default=None, help="save the sections' figures in DIR (needs matplotlib)")
     demo.set_defaults(func=_demo)
     info = commands.add_parser("info", help="print a motion file's skeleton, channels, frame rate and duration")
     info.add_argument("file", help="a .bvh, .amc or .asf file")

@@ -13,6 +13,7 @@ __all__ = ["SECTIONS", "run_demo"]
 SECTIONS = (
     "skmotion._demo.data",
     "skmotion._demo.markers",
+    "skmotion._demo.recognition",
     "skmotion._demo.index",
     "skmotion._demo.primitives",
 )
@@ -30,7 +31,8 @@ def run_demo(write, *, random_state=0, sections=SECTIONS, **options):
     sections : sequence of str, default=SECTIONS
         Modules of the sections to run.
     **options
-        Set on the context for the sections (``data_folder``, ``frame_rate``).
+        Set on the context for the sections (``data_folder``, ``frame_rate``, ``plot_dir``: where
+        sections save their figures when matplotlib is installed).
 
     Returns
     -------

@@ -1,0 +1,94 @@
+"""Decoding collections of clips: groups of similar lengths, decoded in parallel."""
+
+import numpy as np
+
+from skmotion.tree._decode import beam_decode
+from skmotion.utils._parallel import parallel_map
+
+__all__ = ["decode_clips", "length_groups"]
+
+# Clips are decoded in groups of at most this many (step, graph) pairs, counting
+# the padding of shorter clips to the longest of the group. Groups depend on the
+# data only, so results are the same for any n_jobs.
+_GROUP_PAIRS = 1 << 17
+
+
+def length_groups(lengths, n_graphs, budget=_GROUP_PAIRS):
+    """Groups of clips of similar lengths, so little padding is decoded.
+
+    Clips are taken shortest first; a group grows while (its longest clip) x
+    (its clips) x ``n_graphs`` stays within ``budget``.
+
+    Parameters
+    ----------
+    lengths : ndarray of shape (n_clips,)
+    n_graphs : int
+    budget : int, default=131072
+
+    Returns
+    -------
+    groups : list of ndarray
+        Clip indices of each group; together, every clip once.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree._batch import length_groups
+    >>> [g.tolist() for g in length_groups(np.array([5, 50, 6, 40]), n_graphs=1, budget=80)]
+    [[0, 2], [3], [1]]
+    """
+    order = np.argsort(lengths, kind="stable")
+    groups, start = [], 0
+    for end in range(1, len(order) + 1):
+        if end - start > 1 and lengths[order[end - 1]] * (end - start) * n_graphs > budget:
+            groups.append(order[start : end - 1])
+            start = end - 1
+    groups.append(order[start:])
+    return groups
+
+
+def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, node_prior, guide=None, normalise=True,
+                 n_jobs=None):
+    """Beam-decode every clip under every graph (see :func:`beam_decode`).
+
+    Parameters
+    ----------
+    tree : MotionTree
+    graphs : TransitionGraphs
+    frames : ndarray of shape (n_frames, n_channels)
+        The frames of all clips, stacked.
+    offsets : ndarray of shape (n_clips + 1,)
+    n_graphs : int
+        Decode each clip under graphs ``0 .. n_graphs - 1``.
+    layer, n_paths, node_prior, guide, normalise
+        As for :func:`beam_decode`.
+    n_jobs : int, default=None
+        Jobs over the groups of clips (joblib's meaning); results do not depend on it.
+
+    Returns
+    -------
+    paths : list of ndarray of shape (n_graphs, n_paths, n_frames_i)
+        Node sequences of each clip, best first.
+    scores : ndarray of shape (n_clips, n_graphs, n_paths)
+        Their log scores.
+    """
+    lengths = np.diff(offsets)
+
+    def work(group):
+        clip_of_problem = np.repeat(group, n_graphs)
+        graph_of_problem = np.tile(np.arange(n_graphs), len(group))
+        paths, scores = beam_decode(
+            tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, layer=layer, n_paths=n_paths,
+            node_prior=node_prior, guide=guide, normalise=normalise,
+        )
+        return paths.reshape(len(group), n_graphs, *paths.shape[1:]), scores.reshape(len(group), n_graphs, -1)
+
+    groups = length_groups(lengths, n_graphs)
+    results = parallel_map(work, groups, n_jobs=n_jobs)
+    paths = [None] * len(lengths)
+    scores = np.empty((len(lengths), n_graphs, n_paths))
+    for (group_paths, group_scores), group in zip(results, groups):
+        scores[group] = group_scores
+        for i, clip in enumerate(group):
+            paths[clip] = group_paths[i, :, :, : lengths[clip]]
+    return paths, scores

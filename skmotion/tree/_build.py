@@ -1,0 +1,184 @@
+"""Building the motion tree: principal axes and 1-D cuts, layer by layer.
+
+A node's frames are centred and projected on their first principal axis, and
+the sorted projections are cut in two by a 1-D criterion (minimum-error
+thresholding by default); nodes split until they are too small or the tree is
+deep enough. A node that stops early is copied down, so every layer holds all
+frames. Building costs one sort and one ``n x d`` scatter per split node:
+O(N log N) for N frames when the tree is about ``log N`` deep. There are no
+pairwise distances and no Python loop over frames (only over nodes).
+"""
+
+import numpy as np
+from scipy.linalg import eigh
+from scipy.linalg.lapack import dsyevr
+
+from skmotion.tree._gaussian import centred_moments, estimate_covariance
+from skmotion.tree._split import best_split
+
+__all__ = ["build_nodes"]
+
+# A cut must sit in a gap wider than this many units of the projections'
+# rounding error, so routing a training frame again always finds the same side.
+_GAP_RESOLUTION = 1e-12
+
+
+def _top_eigenvectors(symmetric, k):
+    """The ``k`` leading eigenpairs of a symmetric matrix, largest first.
+
+    LAPACK's subset driver computes only the wanted pairs; it is called
+    directly because the wrapper's checks cost as much as the work on the small
+    matrices of tree nodes.
+    """
+    m = len(symmetric)
+    k = min(k, m)
+    values, vectors, _, _, info = dsyevr(symmetric, compute_v=1, range="I", il=m - k + 1, iu=m)
+    if info != 0:  # pragma: no cover - LAPACK failure on a finite symmetric matrix
+        values, vectors = eigh(symmetric, subset_by_index=[m - k, m - 1])
+    return values[:k][::-1], vectors[:, :k][:, ::-1]
+
+
+def _fix_signs(axes):
+    """Flip each row so its largest component is positive (reproducible axes)."""
+    signs = np.sign(axes[np.arange(len(axes)), np.argmax(np.abs(axes), axis=1)])
+    return axes * np.where(signs == 0, 1.0, signs)[:, None]
+
+
+def _principal_axis(centred, scatter):
+    """The unit first principal axis of a node (None when its frames do not vary).
+
+    With fewer frames than channels, ``centred`` (the frames minus their mean)
+    is given and the smaller ``n x n`` problem, which has the same axis, is solved.
+    """
+    if centred is None:
+        values, vectors = _top_eigenvectors(scatter, 1)
+        axis = vectors[:, 0]
+    else:
+        values, vectors = _top_eigenvectors(centred @ centred.T, 1)
+        axis = centred.T @ vectors[:, 0]
+    norm = float(np.sqrt(axis @ axis))
+    if values[0] <= 0.0 or norm == 0.0:
+        return None
+    axis = axis / norm
+    return -axis if axis[np.argmax(np.abs(axis))] < 0 else axis
+
+
+class _Builder:
+    """Breadth-first construction on a copy of the frames in which every node's
+    frames are one contiguous block (splitting a node reorders its block)."""
+
+    def __init__(self, X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar):
+        # Rounding of a projection x @ axis is below d * eps * max|x|; cuts must
+        # sit in gaps far wider, so a training frame always routes back to its side.
+        self.tol = _GAP_RESOLUTION * X.shape[1] * max(float(X.max()), -float(X.min()))
+        self.blocks = X.copy()
+        self.reg_covar = reg_covar
+        self.reg = None  # set from the root's variance
+        self.root_scatter = None
+        self.max_depth = max_depth
+        self.min_split = max(min_samples_split, 2 * min_samples_leaf, 2)
+        self.min_leaf = min_samples_leaf
+        self.split = split
+        self.kind = covariance_type
+        self.nodes = {k: [] for k in ("parent", "depth", "start", "stop", "mean", "cov", "axis", "thr", "left", "right")}
+
+    def add(self, parent, depth, start, stop):
+        for key, value in zip(("parent", "depth", "start", "stop"), (parent, depth, start, stop)):
+            self.nodes[key].append(value)
+        for key, value in (("left", -1), ("right", -1), ("axis", None), ("thr", np.nan), ("mean", None), ("cov", None)):
+            self.nodes[key].append(value)
+        return len(self.nodes["parent"]) - 1
+
+    def process(self, node, may_split):
+        """Compute the node's Gaussian; split it when allowed and possible."""
+        nodes = self.nodes
+        start, stop = nodes["start"][node], nodes["stop"][node]
+        block = self.blocks[start:stop]
+        n, d = block.shape
+        mean, scatter, sq_norms = centred_moments(block)
+        if self.reg is None:  # the root: reg_covar is relative to its mean per-channel variance
+            scale = np.trace(scatter) / (n * d)
+            self.reg = self.reg_covar * scale if scale > 0 else float(self.reg_covar)
+            self.root_scatter = scatter
+        nodes["mean"][node] = mean
+        nodes["cov"][node] = estimate_covariance(scatter, sq_norms, self.kind, self.reg)
+        if not (may_split and n >= self.min_split):
+            return ()
+        axis = _principal_axis(block - mean if n < d else None, scatter)
+        if axis is None:
+            return ()
+        proj = block @ axis  # as routing computes it
+        order = np.argsort(proj, kind="stable")
+        ordered = proj[order]
+        n_left = best_split(ordered, self.split, min_samples_leaf=self.min_leaf, tol=self.tol)
+        if n_left is None:
+            return ()
+        self.blocks[start:stop] = block[order]
+        depth = nodes["depth"][node] + 1
+        left = self.add(node, depth, start, start + n_left)
+        right = self.add(node, depth, start + n_left, stop)
+        nodes["left"][node], nodes["right"][node] = left, right
+        nodes["axis"][node] = axis
+        nodes["thr"][node] = 0.5 * (ordered[n_left - 1] + ordered[n_left])
+        return (left, right)
+
+    def run(self):
+        root = self.add(-1, 0, 0, len(self.blocks))
+        layers = [np.array([root])]
+        depth = 0
+        while True:
+            may_split = self.max_depth is None or depth < self.max_depth
+            next_layer, grew = [], False
+            for node in layers[-1]:
+                if self.nodes["depth"][node] == depth:
+                    children = self.process(node, may_split)
+                else:  # a leaf of an upper layer, copied down
+                    children = ()
+                grew |= bool(children)
+                next_layer.extend(children or (node,))
+            if not grew:
+                break
+            layers.append(np.array(next_layer))
+            depth += 1
+        return layers
+
+
+def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar):
+    """Grow the tree over validated frames; the per-node arrays and the layers.
+
+    Parameters
+    ----------
+    X : ndarray of shape (n_frames, n_channels)
+        C-contiguous, finite frames.
+    max_depth, min_samples_split, min_samples_leaf, split, covariance_type
+        As for :meth:`MotionTree.build`.
+    reg_covar : float
+        Added to every variance, as a fraction of the mean per-channel variance
+        of all frames (absolute when the frames do not vary).
+
+    Returns
+    -------
+    nodes : dict
+        ``parent``, ``left``, ``right``, ``depth``, ``count``, ``mean``,
+        ``covariance``, ``axis``, ``threshold`` (per tree node id), ``layers``,
+        ``principal_axes`` (the first three axes of all frames) and ``reg`` (the
+        absolute regularisation): the arguments of ``MotionTree``.
+    """
+    builder = _Builder(X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar)
+    layers = builder.run()
+    nodes = builder.nodes
+    d = X.shape[1]
+    return {
+        "parent": np.array(nodes["parent"], dtype=np.intp),
+        "left": np.array(nodes["left"], dtype=np.intp),
+        "right": np.array(nodes["right"], dtype=np.intp),
+        "depth": np.array(nodes["depth"], dtype=np.intp),
+        "count": np.array(nodes["stop"], dtype=np.intp) - np.array(nodes["start"], dtype=np.intp),
+        "mean": np.array(nodes["mean"]),
+        "covariance": np.array(nodes["cov"]),
+        "axis": np.array([np.zeros(d) if a is None else a for a in nodes["axis"]]),
+        "threshold": np.array(nodes["thr"], dtype=np.float64),
+        "layers": layers,
+        "principal_axes": _fix_signs(_top_eigenvectors(builder.root_scatter, 3)[1].T),
+        "reg": builder.reg,
+    }

@@ -1,0 +1,440 @@
+"""MotionTreeHMM: recognise, decode and predict motion clips with a motion tree and its graphs."""
+
+from numbers import Integral, Real
+
+import numpy as np
+from scipy.special import logsumexp
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils import Bunch
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import check_is_fitted, column_or_1d
+
+from skmotion.base import ClipEstimatorMixin
+from skmotion.tree._batch import decode_clips
+from skmotion.tree._decode import NODE_PRIORS
+from skmotion.tree._gaussian import COVARIANCE_TYPES
+from skmotion.tree._motion_tree import MotionTree
+from skmotion.tree._split import SPLIT_CRITERIA
+from skmotion.tree._transitions import TransitionGraphs
+from skmotion.utils._clips import check_clips, stack_clips
+from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
+
+__all__ = ["MotionTreeHMM"]
+
+def _check_count(name, value, low=1):
+    if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
+        raise ValueError(f"{name} must be an int >= {low}; got {value!r}.")
+    return int(value)
+
+
+class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
+    """Recognise motion clips with a binary tree of frame clusters and node transition graphs.
+
+    Yamane, Yamaguchi and Nakamura's motion database: ``fit`` builds a
+    :class:`MotionTree` over all frames of all clips and counts, at every layer,
+    the transitions between the nodes of consecutive frames: one global graph
+    and one graph per class (or per clip). A clip's *generation probability*
+    under a graph sums the ``n_paths`` best node sequences found by the
+    top-down beam Viterbi (:func:`beam_decode`); ``predict`` picks the class
+    whose graph generates the clip with the highest probability.
+
+    Parameters
+    ----------
+    max_depth : int, default=10
+        The deepest layer of the tree (the root is layer 0); None for no limit
+        (the paper's choice). Decoding costs one pass per layer, and
+        minimum-error splits can grow very deep trees, hence the default.
+    min_samples_split : int, default=2
+        A node with fewer frames is not split.
+    min_samples_leaf : int, default=16
+        A split is only made when both sides keep this many frames.
+    split : {"min_error", "two_means", "median"}, default="min_error"
+        How a node's projections on its first principal axis are cut:
+        Kittler-Illingworth minimum-error thresholding (the paper's), 1-D
+        2-means, or the median (balanced trees).
+    covariance_type : {"diag", "full", "spherical"}, default="diag"
+        The covariance estimator of each node; ``"full"`` is Ledoit-Wolf shrunk.
+    reg_covar : float, default=1e-6
+        Added to every variance, as a fraction of the mean variance of all frames.
+    graph : {"class", "clip"}, default="class"
+        Classify by one transition graph per class, or by one graph per
+        training clip (a clip is given the label of the training clip whose
+        graph generates it best, as in the paper).
+    node_prior : {"layer", "graph"}, default="layer"
+        Where the uniform prior ``P(k)`` of ``Ps(k | x)`` is spread: over all
+        nodes of the layer, or over the nodes the graph's clips visit (the
+        paper's choice for clip graphs). With ``"graph"``, ``Ps`` is normalised
+        within each graph, so a graph whose clips visit few nodes explains any
+        frame with probability near 1 and classification rests on transitions
+        alone; on the built-in synthetic data (subject-wise CV) that gave 0-14%
+        accuracy with minimum-error splits against 95-100% for ``"layer"``,
+        where how well a graph's nodes fit the frames counts too. See the user
+        guide.
+    smoothing : float, default=1.0
+        Pseudo-transitions added to every row of every transition graph, spread
+        evenly over the layer's nodes (Lidstone smoothing); see
+        :class:`TransitionGraphs`.
+    n_paths : int, default=3
+        The beam: nodes kept per frame at each layer of the top-down search,
+        and the number of best sequences summed into the generation probability.
+    layer : int, default=None
+        The layer to classify at (negative counts from the bottom); None for
+        the bottom layer. Upper layers are faster and coarser.
+    standardize : bool, default=True
+        Scale every channel to zero mean and unit variance (statistics of the
+        training frames; a constant channel is only centred) before building
+        the tree, whose principal axes otherwise follow the channels with the
+        largest units. Node means reported by ``predict_next`` are in the
+        input's units either way.
+    n_jobs : int, default=None
+        Jobs over groups of clips (and their graphs) when decoding; None means
+        1 unless in a ``joblib.parallel_config`` context. Results do not
+        depend on it.
+
+    Attributes
+    ----------
+    tree_ : MotionTree
+        The tree over all training frames.
+    global_graph_ : TransitionGraphs
+        The global transition graph (one graph of all clips), for ``decode``
+        and ``predict_next``.
+    graphs_ : TransitionGraphs
+        The graphs used to classify: one per class, or one per training clip.
+    graph_classes_ : ndarray of shape (n_graphs,)
+        Index in ``classes_`` of each graph of ``graphs_``.
+    classes_ : ndarray of shape (n_classes,)
+        The class labels.
+    layer_ : int
+        The (non-negative) layer used for classification.
+    center_, scale_ : ndarray of shape (n_features_in_,)
+        The standardisation (zeros and ones when ``standardize=False``).
+    n_layers_ : int
+        Number of layers of the tree.
+    n_nodes_ : ndarray of shape (n_layers_,)
+        Number of nodes in each layer.
+    n_features_in_ : int
+        Number of channels.
+    feature_names_in_ : ndarray of str
+        Channel names, when fit saw a DataFrame with string columns.
+
+    See Also
+    --------
+    MotionTree : the tree data structure.
+    TransitionGraphs : the node transition graphs.
+
+    Notes
+    -----
+    ``Ps(k | x) = Po(x | k) / sum_j Po(x | j)`` with ``j`` over the nodes of the
+    prior; everything is computed in log space, so clips of any length give
+    finite scores. Building costs O(N log N) for N frames when the tree is
+    about ``log N`` deep.
+
+    With ``node_prior="layer"`` the layers above ``layer_`` are searched once
+    per clip on the global graph, and each class's (or clip's) graph runs the
+    last K-best pass on the candidates that leaves; this shared beam gave the
+    same accuracy as one search per graph in our measurements, for a fraction
+    of the work. The normaliser of ``Ps`` is then the same for every graph, so
+    ``predict``, ``predict_proba`` and ``decode`` skip it; ``score_samples``
+    computes it (every node's density on every frame). Decoding a clip of M
+    frames costs ``O(M n_paths^2)`` per layer. See the user guide
+    (``docs/motion-database.md``) for the measurements behind these choices.
+
+    References
+    ----------
+    K. Yamane, Y. Yamaguchi and Y. Nakamura, "Human motion database with a
+    binary tree and node transition graphs", Autonomous Robots 30(1), 2011.
+
+    Examples
+    --------
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.tree import MotionTreeHMM
+    >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+    >>> X = [clip[:, 6:] for clip in data.clips]   # joint angles, without the root
+    >>> model = MotionTreeHMM(max_depth=4).fit(X, data.target)
+    >>> model.n_layers_, model.score(X, data.target)
+    (5, 1.0)
+    """
+
+    _parameter_constraints = {
+        "max_depth": [Interval(Integral, 0, None, closed="left"), None],
+        "min_samples_split": [Interval(Integral, 2, None, closed="left")],
+        "min_samples_leaf": [Interval(Integral, 1, None, closed="left")],
+        "split": [StrOptions(set(SPLIT_CRITERIA))],
+        "covariance_type": [StrOptions(set(COVARIANCE_TYPES))],
+        "reg_covar": [Interval(Real, 0, None, closed="neither")],
+        "graph": [StrOptions({"class", "clip"})],
+        "node_prior": [StrOptions(set(NODE_PRIORS))],
+        "smoothing": [Interval(Real, 0, None, closed="neither")],
+        "n_paths": [Interval(Integral, 1, None, closed="left")],
+        "layer": [Interval(Integral, None, None, closed="neither"), None],
+        "standardize": ["boolean"],
+        "n_jobs": [Integral, None],
+    }
+
+    def __init__(
+        self,
+        *,
+        max_depth=10,
+        min_samples_split=2,
+        min_samples_leaf=16,
+        split="min_error",
+        covariance_type="diag",
+        reg_covar=1e-6,
+        graph="class",
+        node_prior="layer",
+        smoothing=1.0,
+        n_paths=3,
+        layer=None,
+        standardize=True,
+        n_jobs=None,
+    ):
+        self.max_depth = max_depth
+        self.min_samples_split = min_samples_split
+        self.min_samples_leaf = min_samples_leaf
+        self.split = split
+        self.covariance_type = covariance_type
+        self.reg_covar = reg_covar
+        self.graph = graph
+        self.node_prior = node_prior
+        self.smoothing = smoothing
+        self.n_paths = n_paths
+        self.layer = layer
+        self.standardize = standardize
+        self.n_jobs = n_jobs
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit(self, X, y):
+        """Build the tree and count the transition graphs.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Training clips (or a 3-D array, or a ``(clip, frame)`` DataFrame).
+        y : array-like of shape (n_clips,)
+            One label per clip (any hashable type, strings included).
+
+        Returns
+        -------
+        self : MotionTreeHMM
+            The fitted model.
+        """
+        clips = check_clips(X, estimator=self, reset=True)
+        y = column_or_1d(np.asarray(y), warn=True)
+        if len(y) != len(clips):
+            raise ValueError(f"y has {len(y)} labels but X holds {len(clips)} clips; give one label per clip.")
+        check_classification_targets(y)
+        self.classes_, y_index = np.unique(y, return_inverse=True)
+        frames, offsets = stack_clips(clips)
+        self.center_ = np.zeros(frames.shape[1])
+        self.scale_ = np.ones(frames.shape[1])
+        if self.standardize:
+            self.center_ = frames.mean(axis=0)
+            spread = frames.std(axis=0)
+            self.scale_ = np.where(spread > 0, spread, 1.0)
+            frames = (frames - self.center_) / self.scale_
+        tree = MotionTree.build(
+            frames,
+            max_depth=self.max_depth,
+            min_samples_split=self.min_samples_split,
+            min_samples_leaf=self.min_samples_leaf,
+            split=self.split,
+            covariance_type=self.covariance_type,
+            reg_covar=self.reg_covar,
+        )
+        self.layer_ = tree.check_layer(-1 if self.layer is None else self.layer)
+        labels = list(tree.iter_apply(frames))
+        n_clips = len(clips)
+        self.global_graph_ = TransitionGraphs.count(
+            labels, tree.n_nodes, offsets=offsets, graph_of_clip=np.zeros(n_clips, dtype=np.intp),
+            n_graphs=1, smoothing=self.smoothing,
+        )
+        if self.graph == "class":
+            graph_of_clip, self.graph_classes_ = y_index, np.arange(len(self.classes_))
+        else:
+            graph_of_clip, self.graph_classes_ = np.arange(n_clips), y_index
+        self.graphs_ = TransitionGraphs.count(
+            labels, tree.n_nodes, offsets=offsets, graph_of_clip=graph_of_clip,
+            n_graphs=len(self.graph_classes_), smoothing=self.smoothing,
+        )
+        self.tree_ = tree
+        self.n_layers_ = tree.n_layers
+        self.n_nodes_ = tree.n_nodes
+        return self
+
+    # -- decoding ------------------------------------------------------------------
+
+    def _decode(self, clips, graphs, layer, n_graphs, exact=True):
+        """Beam-decode every clip under every graph: paths and scores per clip.
+
+        Without ``exact``, and when the normaliser of ``Ps`` is the same for
+        every graph (``node_prior="layer"``), scores skip it: rankings are equal.
+        """
+        normalise = exact or self.node_prior != "layer"
+        # One beam search per clip on the global graph, shared by all graphs. Under
+        # node_prior="graph" a graph may have no candidate left in the shared beam,
+        # so each graph then searches on its own.
+        guide = self.global_graph_ if self.node_prior == "layer" else None
+        frames, offsets = stack_clips(clips)
+        return decode_clips(
+            self.tree_, graphs, (frames - self.center_) / self.scale_, offsets, n_graphs=n_graphs, layer=layer,
+            n_paths=self.n_paths, node_prior=self.node_prior, guide=guide, normalise=normalise, n_jobs=self.n_jobs,
+        )
+
+    def _class_log_probs(self, clips, exact=True):
+        """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
+
+        Without ``exact``, up to a constant per clip (enough to rank classes).
+        """
+        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_), exact)
+        per_graph = logsumexp(scores, axis=2)
+        if self.graph == "class":
+            return per_graph
+        out = np.full((len(clips), len(self.classes_)), -np.inf)
+        np.maximum.at(out.T, self.graph_classes_, per_graph.T)
+        return out
+
+    def score_samples(self, X):
+        """Log generation probability of each clip under each class.
+
+        With ``graph="clip"`` a class's value is that of its best training clip.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        log_prob : ndarray of shape (n_clips, n_classes)
+            ``log`` of the summed probability of the ``n_paths`` best node
+            sequences at ``layer_``; columns follow ``classes_``.
+        """
+        check_is_fitted(self)
+        return self._class_log_probs(check_clips(X, estimator=self))
+
+    def predict_proba(self, X):
+        """Generation probabilities normalised over the classes.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        proba : ndarray of shape (n_clips, n_classes)
+        """
+        check_is_fitted(self)
+        log_prob = self._class_log_probs(check_clips(X, estimator=self), exact=False)
+        return np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True))
+
+    def predict(self, X):
+        """The class whose graph generates each clip with the highest probability.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        labels : ndarray of shape (n_clips,)
+        """
+        check_is_fitted(self)
+        log_prob = self._class_log_probs(check_clips(X, estimator=self), exact=False)
+        return self.classes_[np.argmax(log_prob, axis=1)]
+
+    def predict_proba_windows(self, X, width, step=1):
+        """Class probabilities of sliding windows: the time profiles of the paper's Figures 10-12.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+        width : int
+            Frames per window. A clip shorter than ``width`` gives one window,
+            the whole clip.
+        step : int, default=1
+            Frames between the starts of consecutive windows.
+
+        Returns
+        -------
+        profiles : list of ndarray of shape (n_windows_i, n_classes)
+            For clip ``i``, the windows start at frames
+            ``0, step, 2 step, ...`` up to ``max(n_frames_i - width, 0)``.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        width, step = _check_count("width", width), _check_count("step", step)
+        starts = [np.arange(0, max(len(c) - width, 0) + 1, step) for c in clips]
+        windows = [c[s : s + width] for c, st in zip(clips, starts) for s in st]
+        log_prob = self._class_log_probs(windows, exact=False)
+        proba = np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True))
+        return np.split(proba, np.cumsum([len(s) for s in starts])[:-1])
+
+    def _resolve_layer(self, layer):
+        return self.layer_ if layer is None else self.tree_.check_layer(layer)
+
+    def decode(self, X, layer=None):
+        """The most likely node sequence of each clip on the global graph (state estimation).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+        layer : int, default=None
+            The layer to decode at; ``layer_`` by default.
+
+        Returns
+        -------
+        nodes : list of ndarray of shape (n_frames_i,)
+            Layer indices of the nodes (see ``tree_.node_ids(layer)``).
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        paths, _ = self._decode(clips, self.global_graph_, self._resolve_layer(layer), 1, exact=False)
+        return [p[0, 0] for p in paths]
+
+    def predict_next(self, X, n_steps=1, *, n_best=3, layer=None):
+        """The most likely nodes ``n_steps`` frames after each clip ends (prediction).
+
+        The current node's probability comes from the ``n_paths`` best sequences
+        on the global graph (their normalised probabilities, by last node); it is
+        carried ``n_steps`` transitions forward on the global graph.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+        n_steps : int, default=1
+            How many frames ahead.
+        n_best : int, default=3
+            How many nodes to return per clip (at most the layer's node count).
+        layer : int, default=None
+            The layer to predict at; ``layer_`` by default.
+
+        Returns
+        -------
+        prediction : Bunch
+            nodes : ndarray of shape (n_clips, n_best)
+                Layer indices of the most likely nodes, most likely first.
+            probabilities : ndarray of shape (n_clips, n_best)
+                Their probabilities (the confidence of the prediction).
+            means : ndarray of shape (n_clips, n_best, n_channels)
+                Their mean frames: the predicted states.
+            layer : int
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        n_steps, n_best = _check_count("n_steps", n_steps), _check_count("n_best", n_best)
+        layer = self._resolve_layer(layer)
+        k = self.tree_.n_nodes[layer]
+        paths, scores = self._decode(clips, self.global_graph_, layer, 1, exact=False)
+        weights = np.exp(scores[:, 0] - logsumexp(scores[:, 0], axis=1, keepdims=True))
+        current = np.zeros((len(clips), k))
+        for i, p in enumerate(paths):
+            valid = p[0, :, -1] >= 0
+            np.add.at(current[i], p[0, valid, -1], weights[i, valid])
+        future = self.global_graph_.propagate(layer, 0, current, n_steps)
+        n_best = min(n_best, k)
+        nodes = np.argsort(-future, axis=1, kind="stable")[:, :n_best]
+        return Bunch(
+            nodes=nodes,
+            probabilities=np.take_along_axis(future, nodes, axis=1),
+            means=self.tree_.means(layer)[nodes] * self.scale_ + self.center_,
+            layer=layer,
+        )

@@ -1,0 +1,42 @@
+"""The motion tree's figures draw what the tree and its graphs hold."""
+
+import numpy as np
+import pytest
+
+from skmotion.datasets import make_motions
+from skmotion.tree import MotionTreeHMM
+
+matplotlib = pytest.importorskip("matplotlib")
+matplotlib.use("Agg")
+plotting = pytest.importorskip("skmotion.plotting")
+
+
+@pytest.fixture(scope="module")
+def model():
+    data = make_motions(n_clips_per_class=3, classes=["walk", "jump", "squat"], random_state=0)
+    return MotionTreeHMM(max_depth=4, split="median").fit([c[:, 6:] for c in data.clips], data.target)
+
+
+def test_nodes_sit_at_their_projected_means(model):
+    tree = model.tree_
+    ax = plotting.plot_motion_tree_layer(tree, model.global_graph_, layer=3, axes=(0, 2))
+    expected = (tree.means(3) - tree.mean[0]) @ tree.principal_axes[[0, 2]].T
+    np.testing.assert_allclose(ax.collections[0].get_offsets(), expected)
+
+
+def test_edges_are_the_likely_transitions(model):
+    graphs, layer = model.graphs_, 4
+    ax = plotting.plot_motion_tree_layer(model.tree_, graphs, layer=layer, graph=1, min_probability=0.1)
+    P = graphs.matrix(layer, 1)
+    seen = graphs.counts(layer, 1).toarray() > 0
+    expected = int(((P >= 0.1) & seen & ~np.eye(len(P), dtype=bool)).sum())
+    assert len(ax.get_lines()) == expected > 0
+
+
+def test_layers_and_profiles(model):
+    assert len(plotting.plot_motion_tree_layers(model.tree_, layers=[1, 2]).axes) == 2
+    profile = np.array([[0.2, 0.5, 0.3], [0.1, 0.1, 0.8]])
+    ax = plotting.plot_motion_tree_profile(profile, model.classes_, step=4, frame_rate=2.0)
+    for column, line in enumerate(ax.get_lines()):
+        np.testing.assert_allclose(line.get_xdata(), [0.0, 2.0])
+        np.testing.assert_allclose(line.get_ydata(), profile[:, column])

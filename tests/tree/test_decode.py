@@ -1,0 +1,135 @@
+"""Top-down beam decoding against the exhaustive Viterbi and against enumeration."""
+
+import itertools
+
+import numpy as np
+import pytest
+from scipy.special import logsumexp
+
+from skmotion.tree import MotionTree, TransitionGraphs, beam_decode, exhaustive_viterbi, node_log_posterior
+
+
+@pytest.fixture(scope="module")
+def model():
+    """A small tree (up to 7 nodes a layer) over three clips, with two graphs."""
+    rng = np.random.default_rng(3)
+    frames = np.vstack([rng.normal(c, 1.0, size=(n, 2)) for c, n in [(0, 40), (6, 30), (12, 30)]])
+    rng.shuffle(frames[:70])
+    offsets = np.array([0, 35, 70, 100])
+    tree = MotionTree.build(frames, max_depth=3, min_samples_leaf=8, split="median")
+    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
+                                    graph_of_clip=[0, 0, 1], smoothing=0.5)
+    return tree, graphs, frames
+
+
+def brute_force(tree, graphs, layer, clip, graph, prior):
+    """log P(N | X) of every node sequence, from the definition."""
+    log_ps = node_log_posterior(tree, graphs, layer, clip, prior)[graph]
+    k = log_ps.shape[1]
+    log_pt = np.log(graphs.matrix(layer, graph))
+    out = []
+    for seq in itertools.product(range(k), repeat=len(clip)):
+        score = sum(log_ps[t, n] for t, n in enumerate(seq)) + sum(log_pt[a, b] for a, b in zip(seq[:-1], seq[1:]))
+        out.append(score)
+    return np.sort(np.array(out))[::-1]
+
+
+@pytest.mark.parametrize("prior", ["graph", "layer"])
+@pytest.mark.parametrize("graph", [0, 1])
+def test_exhaustive_viterbi_matches_enumeration(model, prior, graph):
+    tree, graphs, frames = model
+    clip = frames[[0, 50, 80, 5]]
+    for layer in range(tree.n_layers):
+        expected = brute_force(tree, graphs, layer, clip, graph, prior)
+        expected = expected[np.isfinite(expected)][:4]
+        _, scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=4, node_prior=prior)
+        np.testing.assert_allclose(scores[: len(expected)], expected)
+
+
+@pytest.mark.parametrize("prior", ["graph", "layer"])
+@pytest.mark.parametrize("guided", [False, True])
+def test_a_wide_beam_agrees_with_the_exhaustive_viterbi(model, prior, guided):
+    tree, graphs, frames = model
+    clip = frames[[3, 40, 75, 99, 10, 60]]
+    wide = int(tree.n_nodes.max())
+    guide = None
+    if guided:  # the upper layers searched on a one-graph "global" graph
+        guide = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 100],
+                                       graph_of_clip=[0])
+    for graph in (0, 1):
+        for layer in range(tree.n_layers):
+            paths, scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [graph], layer=layer,
+                                        n_paths=wide, node_prior=prior, guide=guide)
+            ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
+                                                     node_prior=prior)
+            np.testing.assert_allclose(scores[0], ex_scores)
+            finite = np.isfinite(ex_scores)
+            np.testing.assert_array_equal(paths[0][finite], ex_paths[finite])
+
+
+@pytest.mark.parametrize("n_paths", [1, 2, 3])
+def test_a_narrow_beam_never_beats_the_exhaustive_search(model, n_paths):
+    tree, graphs, frames = model
+    rng = np.random.default_rng(0)
+    for _ in range(5):
+        clip = frames[rng.integers(0, 100, size=8)]
+        _, scores = beam_decode(tree, graphs, clip, [0, 8], [0], [1], layer=-1, n_paths=n_paths)
+        _, best = exhaustive_viterbi(tree, graphs, -1, clip, 1, n_paths=n_paths)
+        assert (scores[0] <= best + 1e-9).all()
+        # the scores are those of the returned sequences
+        paths, _ = beam_decode(tree, graphs, clip, [0, 8], [0], [1], layer=-1, n_paths=n_paths)
+        log_ps = node_log_posterior(tree, graphs, -1, clip, "graph")[1]
+        log_pt = np.log(graphs.matrix(tree.n_layers - 1, 1))
+        for seq, score in zip(paths[0], scores[0]):
+            if np.isfinite(score):
+                own = log_ps[np.arange(8), seq].sum() + log_pt[seq[:-1], seq[1:]].sum()
+                assert own == pytest.approx(score)
+
+
+def test_node_posteriors_are_normalised(model):
+    tree, graphs, frames = model
+    for prior in ("graph", "layer"):
+        log_ps = node_log_posterior(tree, graphs, -1, frames[::7] * 5, prior)  # far-away frames too
+        np.testing.assert_allclose(logsumexp(log_ps, axis=2), 0.0, atol=1e-9)
+    unvisited = graphs.visits(tree.n_layers - 1) == 0
+    assert np.isneginf(node_log_posterior(tree, graphs, -1, frames[:3], "graph").transpose(1, 0, 2)[:, unvisited]).all()
+
+
+@pytest.mark.parametrize("guided", [False, True])
+def test_clips_of_different_lengths_decode_as_if_alone(model, guided):
+    tree, graphs, frames = model
+    guide = graphs if guided else None  # graph 0 of it guides
+    offsets = np.array([0, 1, 9, 30, 33])
+    clips, problems = [0, 1, 2, 3, 2, 0], [0, 1, 1, 0, 0, 1]
+    paths, scores = beam_decode(tree, graphs, frames, offsets, clips, problems, layer=-1, n_paths=3, guide=guide)
+    for i, (c, g) in enumerate(zip(clips, problems)):
+        clip = frames[offsets[c] : offsets[c + 1]]
+        alone_paths, alone_scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [g], layer=-1, n_paths=3,
+                                                guide=guide)
+        np.testing.assert_allclose(scores[i], alone_scores[0])
+        np.testing.assert_array_equal(paths[i][:, : len(clip)], alone_paths[0])
+
+
+def test_layer_zero_is_the_root_with_probability_one(model):
+    tree, graphs, frames = model
+    paths, scores = beam_decode(tree, graphs, frames[:5], [0, 5], [0], [0], layer=0, n_paths=2)
+    assert scores[0].tolist() == [0.0, -np.inf]
+    assert paths[0, 0].tolist() == [0] * 5 and (paths[0, 1] == -1).all()
+
+
+def test_ten_thousand_frames_keep_finite_probabilities(model):
+    tree, graphs, frames = model
+    clip = frames[np.arange(10_000) % 100]
+    paths, scores = beam_decode(tree, graphs, clip, [0, 10_000], [0], [0], layer=-1, n_paths=2)
+    assert np.isfinite(scores).all() and scores[0, 0] < -1000  # far below the smallest double
+    assert (paths[0] >= 0).all()
+
+
+def test_the_normaliser_survives_underflow():
+    from skmotion.tree._decode import _log_normaliser
+
+    log_po = np.array([[0.0, -2000.0, -2001.0], [-5.0, -6.0, -7.0]])
+    allowed = np.array([[True, True, True], [False, True, True]])
+    expected = [[logsumexp(log_po[i][allowed[g]]) for g in range(2)] for i in range(2)]
+    np.testing.assert_allclose(_log_normaliser(log_po, allowed), expected)
+    assert np.isfinite(_log_normaliser(log_po, allowed)).all()
