@@ -4,6 +4,7 @@ from numbers import Integral, Real
 
 import numpy as np
 import pandas as pd
+import scipy.sparse as sp
 from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.metrics.pairwise import euclidean_distances
 from sklearn.utils.multiclass import check_classification_targets
@@ -33,12 +34,16 @@ def _is_table(X):
     is a table.
     """
     if isinstance(X, (list, tuple)):
-        return len(X) > 0 and np.ndim(X[0]) == 1
+        # All rows 1-D: a list with one 1-D clip among 2-D ones is a clip collection
+        # with a bad clip, which check_clips names.
+        return len(X) > 0 and all(np.ndim(x) == 1 for x in X)
     if isinstance(X, np.ndarray):
         return X.ndim != 3
     if isinstance(X, pd.DataFrame):
         return not isinstance(X.index, pd.MultiIndex)
-    return True
+    # Array-likes are tables; anything else (None, a dict, a file name) goes to
+    # check_clips, whose TypeError names what was given.
+    return sp.issparse(X) or hasattr(X, "__array__")
 
 
 def learn_delta(features, labels, quantile):
