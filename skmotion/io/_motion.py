@@ -1,5 +1,7 @@
 """The Motion: one clip read from a file, with the skeleton it belongs to."""
 
+from numbers import Real
+
 import numpy as np
 
 from skmotion.kinematics import Skeleton, forward_kinematics
@@ -63,6 +65,9 @@ class Motion:
                 f"channels must have shape (n_frames, {skeleton.n_channels}) for this skeleton; "
                 f"got {channels.shape}."
             )
+        if not isinstance(frame_rate, Real) or isinstance(frame_rate, bool):
+            # A string or None is not parsed or guessed: say what was given.
+            raise TypeError(f"frame_rate must be a number of Hz, got {type(frame_rate).__name__} {frame_rate!r}.")
         frame_rate = float(frame_rate)
         if not frame_rate > 0 or not np.isfinite(frame_rate):
             raise ValueError(f"frame_rate must be a positive number of Hz, got {frame_rate!r}.")

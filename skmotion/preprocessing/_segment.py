@@ -6,10 +6,13 @@ to the next one, both included, so consecutive segments of one stroke share
 their boundary frame.
 """
 
+from numbers import Real
+
 import numpy as np
 from scipy.signal import find_peaks
 
 from skmotion.preprocessing._filter import lowpass_filter
+from skmotion.utils._sklearn_compat import Interval, validate_params
 
 __all__ = [
     "SEGMENTATION_RULES",
@@ -23,6 +26,10 @@ __all__ = [
 #: The segmentation rules, by name.
 SEGMENTATION_RULES = ("energy", "zvc")
 
+# A frame rate of zero, a negative or NaN one, or a string would give silently
+# wrong velocities; inside an estimator's fit (already validated) this is skipped.
+_POSITIVE = Interval(Real, 0, None, closed="neither")
+
 
 def _velocity(clip, frame_rate):
     if len(clip) < 2:
@@ -30,6 +37,7 @@ def _velocity(clip, frame_rate):
     return np.gradient(np.asarray(clip, dtype=float), axis=0) * frame_rate
 
 
+@validate_params({"frame_rate": [_POSITIVE]}, prefer_skip_nested_validation=True)
 def movement_energy(clip, *, frame_rate=1.0):
     """The sum of squared channel velocities, ``z(t) = sum_j (dtheta_j/dt)^2``.
 
@@ -128,6 +136,7 @@ def _group_starts(frames, width):
     return np.asarray(starts, dtype=np.intp)
 
 
+@validate_params({"frame_rate": [_POSITIVE]}, prefer_skip_nested_validation=True)
 def zvc_segments(clip, *, frame_rate, window=0.3, min_channels=2, min_movement=0.0):
     """Segments between zero-velocity crossings shared by several channels (SEG-1).
 
@@ -192,6 +201,7 @@ def zvc_segments(clip, *, frame_rate, window=0.3, min_channels=2, min_movement=0
     return _keep_moving(clip, _as_segments(segments), min_movement)
 
 
+@validate_params({"frame_rate": [_POSITIVE, None]}, prefer_skip_nested_validation=True)
 def energy_segments(clip, *, threshold=None, ratio=0.1, frame_rate=None, min_movement=0.0):
     """Segments of high movement energy between low-energy boundaries (SEG-2).
 
@@ -260,6 +270,7 @@ def energy_segments(clip, *, threshold=None, ratio=0.1, frame_rate=None, min_mov
     return _keep_moving(clip, _as_segments(np.c_[start, stop + 1]), min_movement)
 
 
+@validate_params({"frame_rate": [_POSITIVE, None]}, prefer_skip_nested_validation=True)
 def segment_clip(
     clip,
     *,

@@ -107,12 +107,6 @@ def _as_float_clip(clip, clip_index, dtype, input_name):
         raise ValueError(
             f"{input_name}: clip {clip_index} has complex values; clips must be real."
         )
-    if arr.dtype.kind in "USa":
-        # As sklearn: text is not silently parsed into numbers (nothing is guessed).
-        raise ValueError(
-            f"{input_name}: clip {clip_index} has string data (dtype {arr.dtype}); "
-            "convert it to numbers explicitly first."
-        )
     if arr.dtype.kind not in "biuf":
         try:
             arr = arr.astype(np.float64)
