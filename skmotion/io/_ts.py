@@ -5,6 +5,7 @@ from pathlib import Path
 import numpy as np
 
 from skmotion.io._errors import MotionFileError
+from skmotion.io._text import read_bytes
 
 __all__ = ["read_ts"]
 
@@ -47,10 +48,18 @@ def _parse_header(path, lines):
 def _parse_dimension(path, number, index, text):
     values = text.replace("?", "nan").split(",")
     try:
-        return np.array(values, dtype=float)
+        column = np.array(values, dtype=float)
     except ValueError:
         bad = next(v for v in values if not _is_float(v))
         raise MotionFileError(path, number, f"dimension {index + 1}: non-numeric value {bad.strip()!r}") from None
+    infinite = np.flatnonzero(np.isinf(column))
+    if infinite.size:
+        # NaN is a missing value (written '?'); an infinity is a broken value.
+        raise MotionFileError(
+            path, number, f"dimension {index + 1}: non-finite value {values[infinite[0]].strip()!r} "
+            f"at position {infinite[0] + 1} (write missing values as '?')"
+        )
+    return column
 
 
 def _is_float(text):
@@ -105,7 +114,7 @@ def read_ts(path):
     """
     path = Path(path)
     try:
-        lines = path.read_text().splitlines()
+        lines = read_bytes(path).decode("utf-8").splitlines()
     except UnicodeDecodeError as exc:
         raise MotionFileError(path, None, f"not a text file ({exc.reason})") from None
     tags, data_line = _parse_header(path, lines)
