@@ -141,7 +141,7 @@ def _axis_order(lines, line, word):
 
 
 def _parse_bone(lines, opened):
-    bone = {"line": opened, "dof": [], "axis": None}
+    bone = {"line": opened, "dof": []}
     while True:
         line, words = lines.take(f"'end' of the bone opened at line {opened}")
         key = words[0].lower()

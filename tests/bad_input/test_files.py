@@ -61,6 +61,8 @@ HAND_MADE = [
     ("ASF: length a word", "asf", ASF.replace("length 7.6", "length long").encode(), r"line \d+: non-numeric value 'long'"),
     ("ASF: direction inf", "asf", ASF.replace("direction 0.1 -0.9 0.3", "direction 0.1 inf 0.3").encode(),
      r"line 37: non-finite value in direction"),
+    ("ASF: a bone without axis", "asf", ASF.replace("     axis 10 -25 20  XYZ\n", "").encode(),
+     r"line 23: the bone opened here has no 'axis'"),
     ("ASF: a bone twice in the hierarchy", "asf", ASF.replace("femur tibia", "femur tibia\n    root tibia").encode(),
      r"line \d+: .*tibia"),
     ("empty AMC", "amc", b"", r"no frame number"),
