@@ -13,8 +13,6 @@ import re
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
-from hypothesis import strategies as st
 
 from skmotion.io import MotionFileError, read_amc, read_asf, read_bvh, read_ts
 from tests.bad_input import files
@@ -36,15 +34,7 @@ READERS = {"bvh": read_bvh, "asf": read_asf, "amc": _amc_reader, "ts": read_ts}
 # (what, format, file bytes, message pattern after "<file>, line N: " or "<file>: ")
 HAND_MADE = [
     ("empty BVH", "bvh", b"", r"no MOTION block"),
-    ("binary junk as BVH", "bvh", bytes(range(256)) * 4, r"no MOTION block|expected 'HIERARCHY'"),
-    ("BVH: Frame Time 0", "bvh", LEG.replace("Frame Time: 0.008333", "Frame Time: 0").encode(),
-     r"line 23: Frame Time must be positive"),
-    ("BVH: Frame Time negative", "bvh", LEG.replace("Frame Time: 0.008333", "Frame Time: -0.1").encode(),
-     r"line 23: Frame Time must be positive"),
-    ("BVH: Frame Time nan", "bvh", LEG.replace("Frame Time: 0.008333", "Frame Time: nan").encode(),
-     r"line 23: Frame Time must be positive"),
-    ("BVH: Frame Time a word", "bvh", LEG.replace("Frame Time: 0.008333", "Frame Time: fast").encode(),
-     r"line 23: non-numeric Frame Time 'fast'"),
+    ("binary junk as BVH", "bvh", bytes(range(256)) * 4, r"no MOTION block \(not a BVH file, or truncated\)"),
     ("BVH: no frames", "bvh", (LEG.split("Frames:")[0] + "Frames: 0\nFrame Time: 0.008333\n").encode(),
      r"line 22: the file holds no frames"),
     ("BVH: NaN value", "bvh", LEG.replace("10 90 0 90", "10 nan 0 90").encode(), r"line 25: non-finite value 'nan'"),
@@ -56,8 +46,8 @@ HAND_MADE = [
     ("BVH: joint name twice", "bvh", LEG.replace("JOINT tail", "JOINT knee").encode(),
      r"line \d+: joint name 'knee' appears twice"),
     ("BVH: a brace too many", "bvh", LEG.replace("MOTION", "}\nMOTION").encode(), r"line 21: unexpected '}'"),
-    ("empty ASF", "asf", b"", r"no :root section|:bonedata|:hierarchy"),
-    ("binary junk as ASF", "asf", bytes(range(256)) * 4, r"."),
+    ("empty ASF", "asf", b"", r"no :root section: not an ASF file"),
+    ("binary junk as ASF", "asf", bytes(range(256)) * 4, r"line 1: expected a ':section' keyword, found '\\x00"),
     ("ASF: length a word", "asf", ASF.replace("length 7.6", "length long").encode(), r"line \d+: non-numeric value 'long'"),
     ("ASF: direction inf", "asf", ASF.replace("direction 0.1 -0.9 0.3", "direction 0.1 inf 0.3").encode(),
      r"line 37: non-finite value in direction"),
@@ -72,7 +62,7 @@ HAND_MADE = [
     ("AMC: bone name only", "amc", re.sub(r"(\nback )\S+", r"\nback", AMC, count=1).encode(),
      r"line 7: bone 'back' has 0 values"),
     ("empty .ts", "ts", b"", r"no @data tag"),
-    ("binary junk as .ts", "ts", bytes(range(128, 256)) * 4, r"not a text file|no @data|data before the @data tag"),
+    ("binary junk as .ts", "ts", bytes(range(128, 256)) * 4, r"not a text file \(invalid start byte\)"),
     (".ts: no series", "ts", TS.split("@data")[0].encode() + b"@data\n", r"no series after @data"),
     (".ts: undeclared label", "ts", TS.replace("7,8:9,10:run", "7,8:9,10:jump").encode(),
      r"line 9: class label 'jump' is not declared"),
@@ -83,6 +73,14 @@ HAND_MADE = [
     (".ts: bad dimensions tag", "ts", TS.replace("@dimensions 2", "@dimensions two").encode(),
      r"line 4: @dimensions must be an integer"),
     (".ts: inf value", "ts", TS.replace("7,8:9,10", "7,inf:9,10").encode(), r"line 9: dimension 1: non-finite value 'inf' at position 2"),
+]
+
+# The Frame Time line of LEG (line 23) replaced by each bad value.
+HAND_MADE += [
+    (f"BVH: Frame Time {value}", "bvh", LEG.replace("Frame Time: 0.008333", f"Frame Time: {value}").encode(),
+     f"line 23: {message}")
+    for value, message in [("0", "Frame Time must be positive"), ("-0.1", "Frame Time must be positive"),
+                           ("nan", "Frame Time must be positive"), ("fast", "non-numeric Frame Time 'fast'")]
 ]
 
 
