@@ -7,7 +7,6 @@ Each entry builds a fresh estimator and its fit data: a list of clips and labels
 from dataclasses import dataclass
 from functools import lru_cache
 
-
 from skmotion.control import KMeansPrimitiveController
 from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
