@@ -183,14 +183,14 @@ def test_unmutated_sources_read_and_agree_with_the_references(tmp_path, request,
 @pytest.mark.parametrize("name", list(SOURCES))
 def test_every_line_deleted_or_duplicated(tmp_path, request, name):
     """Systematically, not by chance: each line deleted, then duplicated (every line of
-    the written files; of the longer real excerpts, lines spread evenly, ~150)."""
+    the written files; of the longer real excerpts, lines spread evenly, ~100)."""
     kind, source, asf_source = SOURCES[name]
     shared = request.getfixturevalue("shared_data") if name.startswith("real") else None
     base = source(shared, tmp_path)
     read = files.reader_for(kind, tmp_path, asf_source(shared, tmp_path) if asf_source else None)
     lines = base.split(b"\n")
     outcomes = []
-    for i in range(0, len(lines), max(1, len(lines) // 150) if name.startswith("real") else 1):
+    for i in range(0, len(lines), max(1, len(lines) // 100) if name.startswith("real") else 1):
         outcomes.append(read_mutated(tmp_path, kind, read, f"delete line {i + 1}", b"\n".join(lines[:i] + lines[i + 1 :])))
         outcomes.append(read_mutated(tmp_path, kind, read, f"duplicate line {i + 1}", b"\n".join(lines[: i + 1] + lines[i:])))
     assert "MotionFileError" in outcomes

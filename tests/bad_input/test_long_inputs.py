@@ -1,6 +1,7 @@
 """Long clips through MotionTreeHMM and long files through the readers: finite, consistent.
 
-The sizes here are moderate (about 10^4 frames) to keep the suite fast; the
+The sizes here are moderate (about 5000 frames through MotionTreeHMM, 2 x 10^4
+through the readers) to keep the suite fast; the
 benchmark ``benchmarks/bench_long_inputs.py`` runs 10^5 frames and more and
 reports time and peak memory against the input's own size.
 """
@@ -21,7 +22,7 @@ def hmm():
 
 def test_long_clip_log_likelihood_is_finite_and_grows_linearly(hmm):
     model, base = hmm
-    repeats = 8  # about 7000 frames
+    repeats = 6  # about 5000 frames
     short, long = base, long_clip(base, repeats * len(base))
     per_frame_short = model.score_samples([short])[0] / len(short)
     log_lik = model.score_samples([long])[0]
@@ -37,7 +38,7 @@ def test_long_clip_log_likelihood_is_finite_and_grows_linearly(hmm):
 
 def test_long_clip_decodes_like_its_parts(hmm):
     model, base = hmm
-    repeats = 8
+    repeats = 6
     states = model.decode([long_clip(base, repeats * len(base))])[0]
     assert states.shape == (repeats * len(base),) and states.dtype.kind == "i"
     assert ((states >= 0) & (states < len(model.tree_.node_ids(model.layer_)))).all()
