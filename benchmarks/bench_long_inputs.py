@@ -1,8 +1,9 @@
 """Long inputs: time and peak memory of MotionTreeHMM and the readers on 10^4 to 10^6 frames.
 
 Each measurement runs in a fresh subprocess, which reports its wall time and the
-growth of its peak resident memory during the call (``ru_maxrss`` after minus
-before, so the interpreter, the libraries and the fitted model are not counted).
+growth of its peak resident memory during the call (Linux's ``VmHWM``, reset just
+before the call, minus the resident size then: the interpreter, the libraries and
+the fitted model are not counted).
 The ratio ``extra_MB / input_MB`` compares that growth with the input's own size:
 the clip's float64 array for MotionTreeHMM, the channel array read for the
 readers. Peers in the same run: hmmlearn's ``GaussianHMM.decode`` (Viterbi in C,
@@ -23,7 +24,6 @@ adds 10^6 frames for the readers; ``--quick`` runs 10^3 and 10^4). Needs the
 
 import argparse
 import json
-import resource
 import subprocess
 import sys
 import tempfile
@@ -38,15 +38,26 @@ from _common import write_results  # noqa: E402
 from tests.bad_input.long_inputs import fitted_hmm, long_clip, write_long_amc, write_long_bvh  # noqa: E402
 
 
-def _maxrss_bytes():
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024  # kilobytes on Linux
+def _status_bytes(field):
+    """A memory figure of this process from /proc/self/status (Linux), in bytes."""
+    for line in Path("/proc/self/status").read_text().splitlines():
+        if line.startswith(field + ":"):
+            return int(line.split()[1]) * 1024
+    raise KeyError(field)
 
 
 def _measure(call):
-    before = _maxrss_bytes()
+    """(result, seconds, growth of peak resident memory during the call).
+
+    The peak (VmHWM) is reset to the current resident size first: ``ru_maxrss``
+    would not do, as a child process inherits its parent's peak across exec.
+    """
+    Path("/proc/self/clear_refs").write_text("5")
+    before = _status_bytes("VmRSS")
     start = time.perf_counter()
     result = call()
-    return result, time.perf_counter() - start, _maxrss_bytes() - before
+    seconds = time.perf_counter() - start
+    return result, seconds, _status_bytes("VmHWM") - before
 
 
 def worker(operation, n_frames, folder):
@@ -88,6 +99,7 @@ def worker(operation, n_frames, folder):
             channels = motion.channels
         assert channels.shape[0] == n_frames
         out["finite"] = bool(np.isfinite(channels).all())
+        out["file_bytes"] = (folder / ("long.amc" if operation == "read_amc" else "long.bvh")).stat().st_size
         input_bytes = channels.nbytes
     out.update(seconds=seconds, extra_bytes=extra, input_bytes=input_bytes)
     print(json.dumps(out))
@@ -106,6 +118,7 @@ def _row(what, n_frames, result, peer=None):
         "seconds": result["seconds"],
         "us_per_frame": 1e6 * result["seconds"] / n_frames,
         "input_MB": result["input_bytes"] / 1e6,
+        "file_MB": result["file_bytes"] / 1e6 if "file_bytes" in result else "",
         "extra_MB": result["extra_bytes"] / 1e6,
         "extra_per_input": result["extra_bytes"] / result["input_bytes"],
         "finite": result["finite"],
@@ -142,8 +155,9 @@ def main(hmm_sizes, reader_sizes):
     write_results(
         "long_inputs",
         rows,
-        notes="Time and growth of peak resident memory (ru_maxrss, each measurement in a fresh process) against "
-        "the input's own size (extra_per_input). time_vs_peer / extra_vs_peer: skmotion over the peer, same "
+        notes="Time and growth of peak resident memory (VmHWM reset before the call, each measurement in a fresh "
+        "process) against "
+        "the input's own size (extra_per_input; input: the clip, or the channel array read from a file of file_MB). time_vs_peer / extra_vs_peer: skmotion over the peer, same "
         "input. loglik_per_frame: the best class's log-likelihood per frame (the same at every length: no "
         "underflow).",
     )
