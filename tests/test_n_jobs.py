@@ -23,7 +23,7 @@ from skmotion.tree import _batch
 from skmotion.utils import _parallel
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
-from tests.test_persistence import skmotion_estimators
+from tests.test_persistence import _motions, skmotion_estimators
 
 
 class RecordingParallel(_parallel.Parallel):
@@ -48,11 +48,6 @@ def small_tasks(monkeypatch):
     monkeypatch.setattr(RecordingParallel, "calls", [])
     monkeypatch.setattr(_parallel, "Parallel", RecordingParallel)
     return RecordingParallel.calls
-
-
-def _motions():
-    data = make_motions(n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1)
-    return [c[:, 6:] for c in data.clips], data.target_names[data.target]
 
 
 def _joint_angles():
