@@ -1,5 +1,6 @@
 """Base mixins for estimators whose samples are motion clips."""
 
+import re
 from dataclasses import dataclass
 
 import numpy as np
@@ -9,7 +10,15 @@ from sklearn.base import TransformerMixin
 
 from skmotion.utils._clips import to_container
 
-__all__ = ["ClipEstimatorMixin", "ClipFeatureMixin", "ClipTransformerMixin", "MotionTags"]
+__all__ = [
+    "ClipEstimatorMixin",
+    "ClipFeatureMixin",
+    "ClipTransformerMixin",
+    "IncompatibleVersionError",
+    "MotionTags",
+    "VersionedStateMixin",
+    "compatible_versions",
+]
 
 OUTPUT_KINDS = frozenset({"clips", "table", "labels", "scores", "segments"})
 
@@ -44,12 +53,94 @@ class MotionTags:
             )
 
 
-class ClipEstimatorMixin:
+class IncompatibleVersionError(ValueError):
+    """A pickled skmotion object was saved by an incompatible skmotion version.
+
+    See :func:`compatible_versions` for what "compatible" means.
+    """
+
+
+_VERSION_KEY = "_skmotion_version"
+
+
+def _major_minor(version):
+    match = re.match(r"(\d+)\.(\d+)", str(version))
+    return (int(match[1]), int(match[2])) if match else None
+
+
+def compatible_versions(saved, running):
+    """Whether an object pickled by skmotion ``saved`` can load into skmotion ``running``.
+
+    Two versions are compatible when their major and minor numbers agree
+    (``0.1.0`` and ``0.1.3`` are, ``0.1.3`` and ``0.2.0`` are not): patch
+    releases keep the layout of fitted state, minor releases may change it. An
+    unknown or unparsable version is compatible with nothing.
+
+    Parameters
+    ----------
+    saved : str or None
+        The version recorded in the pickle.
+    running : str
+        The version trying to load it.
+
+    Returns
+    -------
+    compatible : bool
+
+    Examples
+    --------
+    >>> from skmotion.base import compatible_versions
+    >>> compatible_versions("0.1.0", "0.1.4"), compatible_versions("0.1.4", "0.2.0")
+    (True, False)
+    """
+    saved_mm, running_mm = _major_minor(saved), _major_minor(running)
+    return saved_mm is not None and saved_mm == running_mm
+
+
+def _running_version():
+    import skmotion  # at call time, so a test can stand in another version
+
+    return skmotion.__version__
+
+
+class VersionedStateMixin:
+    """Pickles record the skmotion version; loading refuses an incompatible one.
+
+    ``__getstate__`` adds ``_skmotion_version`` to the pickled state (beside
+    sklearn's own); ``__setstate__`` raises :class:`IncompatibleVersionError`
+    when the recorded version is not :func:`compatible_versions` with the running
+    one. scikit-learn only warns on a version mismatch; skmotion refuses because
+    its fitted state holds its own data structures (motion trees, interval
+    indexes, transition graphs) whose layout may change between minor versions,
+    and loading an old layout would give wrong results or fail far from the cause.
+    Every clip estimator gets this through :class:`ClipEstimatorMixin`.
+    """
+
+    def __getstate__(self):
+        state = super().__getstate__()
+        return dict(state, **{_VERSION_KEY: _running_version()})
+
+    def __setstate__(self, state):
+        state = dict(state)
+        saved, running = state.pop(_VERSION_KEY, None), _running_version()
+        if not compatible_versions(saved, running):
+            saved_text = f"skmotion {saved}" if saved is not None else "an unknown skmotion version"
+            raise IncompatibleVersionError(
+                f"This {type(self).__name__} was saved by {saved_text} and cannot be loaded by "
+                f"skmotion {running}: fitted state is only compatible within one major.minor "
+                f"version. Load it with skmotion {saved or '(the saving version)'} installed, or "
+                f"refit it with skmotion {running}."
+            )
+        super().__setstate__(state)
+
+
+class ClipEstimatorMixin(VersionedStateMixin):
     """Mixin for estimators whose ``X`` is a collection of clips.
 
     Sets sklearn's input tags (no 2-D tables, 3-D arrays accepted) and exposes
-    :class:`MotionTags` through ``__skmotion_tags__``. Put it first in the bases,
-    before sklearn's mixins and ``BaseEstimator``.
+    :class:`MotionTags` through ``__skmotion_tags__``. Pickles record the skmotion
+    version (:class:`VersionedStateMixin`). Put it first in the bases, before
+    sklearn's mixins and ``BaseEstimator``.
     """
 
     _motion_tags = MotionTags()
