@@ -16,8 +16,12 @@ from hypothesis import strategies as st
 from skmotion.io import MotionFileError
 from tests.bad_input import files
 
+# A deadline catches a reader that hangs on a mutated file (a read takes milliseconds;
+# the bound is generous for a loaded 2-core CI machine).
 MUTATION_SETTINGS = settings(
-    max_examples=40, suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow]
+    max_examples=40,
+    deadline=10_000,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )
 _NUMBER = re.compile(rb"(?<![\w.])-?\d+(\.\d+)?([eE][-+]?\d+)?(?![\w.])")
 
