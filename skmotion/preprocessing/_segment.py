@@ -55,6 +55,12 @@ def movement_energy(clip, *, frame_rate=1.0):
     -------
     z : ndarray of shape (n_frames,)
 
+    Raises
+    ------
+    ValueError
+        For a ``frame_rate`` that is not a positive, finite number of Hz
+        (sklearn's ``InvalidParameterError``).
+
     Examples
     --------
     >>> import numpy as np
@@ -171,6 +177,12 @@ def zvc_segments(clip, *, frame_rate, window=0.3, min_channels=2, min_movement=0
     segments : ndarray of int of shape (n_segments, 2)
         ``(start, stop)`` of each segment; ``clip[start:stop]`` holds it.
 
+    Raises
+    ------
+    ValueError
+        For a ``frame_rate`` that is not a positive, finite number of Hz
+        (sklearn's ``InvalidParameterError``).
+
     Examples
     --------
     >>> import numpy as np
@@ -233,6 +245,12 @@ def energy_segments(clip, *, threshold=None, ratio=0.1, frame_rate=None, min_mov
     -------
     segments : ndarray of int of shape (n_segments, 2)
         ``(start, stop)`` of each segment; ``clip[start:stop]`` holds it.
+
+    Raises
+    ------
+    ValueError
+        For a ``frame_rate`` that is not a positive, finite number of Hz
+        (sklearn's ``InvalidParameterError``).
 
     Examples
     --------
@@ -314,6 +332,12 @@ def segment_clip(
     -------
     segments : ndarray of int of shape (n_segments, 2)
         ``(start, stop)`` of each segment.
+
+    Raises
+    ------
+    ValueError
+        For a ``frame_rate`` that is not a positive, finite number of Hz
+        (sklearn's ``InvalidParameterError``).
 
     Examples
     --------
