@@ -87,3 +87,19 @@ def test_propagate_is_a_matrix_power(rng):
 def test_smoothing_must_be_positive():
     with pytest.raises(ValueError, match="smoothing must be a positive number"):
         TransitionGraphs.count([np.zeros(3, int)], [1], offsets=[0, 3], graph_of_clip=[0], smoothing=0)
+
+
+def test_log_prob_all_reads_every_graph_at_once(monkeypatch, rng):
+    labels = rng.integers(0, 6, size=150)
+    args = dict(offsets=[0, 40, 90, 150], graph_of_clip=[0, 1, 2], smoothing=0.7)
+    dense = TransitionGraphs.count([labels], [6], **args)
+    monkeypatch.setattr(_transitions, "_DENSE_LIMIT", 0)
+    sparse = TransitionGraphs.count([labels], [6], **args)
+    src, dst = rng.integers(-1, 7, (4, 5)), rng.integers(-1, 7, (4, 5))
+    expected = np.stack([dense.log_prob(0, g, src, dst)
+                         for g in range(3)], axis=-1)
+    for graphs in (dense, sparse):
+        np.testing.assert_array_equal(graphs.log_prob_all(0, src, dst), expected)
+    # against the probabilities themselves
+    P = dense.matrix(0, 1)
+    np.testing.assert_allclose(np.exp(dense.log_prob_all(0, [2], [4])[0, 1]), P[2, 4])
