@@ -48,7 +48,7 @@ def length_groups(lengths, n_graphs, budget=_GROUP_PAIRS):
 
 
 def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, node_prior, guide=None, normalise=True,
-                 n_jobs=None):
+                 prune=False, n_jobs=None):
     """Beam-decode every clip under every graph (see :func:`beam_decode`).
 
     Parameters
@@ -60,7 +60,7 @@ def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, nod
     offsets : ndarray of shape (n_clips + 1,)
     n_graphs : int
         Decode each clip under graphs ``0 .. n_graphs - 1``.
-    layer, n_paths, node_prior, guide, normalise
+    layer, n_paths, node_prior, guide, normalise, prune
         As for :func:`beam_decode`.
     n_jobs : int, default=None
         Jobs over the groups of clips (joblib's meaning); results do not depend on it.
@@ -79,7 +79,7 @@ def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, nod
         graph_of_problem = np.tile(np.arange(n_graphs), len(group))
         paths, scores = beam_decode(
             tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, layer=layer, n_paths=n_paths,
-            node_prior=node_prior, guide=guide, normalise=normalise,
+            node_prior=node_prior, guide=guide, normalise=normalise, prune=prune,
         )
         return paths.reshape(len(group), n_graphs, *paths.shape[1:]), scores.reshape(len(group), n_graphs, -1)
 

@@ -19,7 +19,7 @@ reference and small problems.
 import numpy as np
 from scipy.special import logsumexp
 
-from skmotion.tree._viterbi import kbest_viterbi, max_marginals
+from skmotion.tree._viterbi import best_scores, kbest_viterbi, max_marginals
 
 __all__ = ["NODE_PRIORS", "beam_decode", "exhaustive_viterbi", "node_log_posterior"]
 
@@ -173,14 +173,34 @@ def _emissions(tree, layer, frames, pos, cand, graph_of_problem, allowed, normal
     return emit
 
 
-def _trellis(graphs, layer, cand, emit, graph_of_problem, pad):
-    """The candidates' trellis ``(initial, steps)`` for :mod:`_viterbi`."""
-    steps = graphs.log_prob(layer, graph_of_problem, cand[:-1, :, None, :], cand[1:, None, :, :])
+def _trellis(graphs, layer, cand, emit, graph_of_problem, pad, moves=None):
+    """The candidates' trellis ``(initial, steps)`` for :mod:`_viterbi`.
+
+    ``moves``, when given, holds the transitions' log probabilities already.
+    """
+    if moves is None:
+        moves = graphs.log_prob(layer, graph_of_problem, cand[:-1, :, None, :], cand[1:, None, :, :])
+    steps = moves
     steps += emit[1:, None, :, :]
     # A padded step repeats the last frame: identity moves of score 0.
     t, b = np.nonzero(pad[1:])
     steps[t, :, :, b] = np.where(np.eye(cand.shape[1], dtype=bool), 0.0, -np.inf)
     return emit[0], steps
+
+
+def _shared_moves(graphs, layer, cand, clip_of_problem, graph_of_problem):
+    """Transition log probabilities of problems that share their clip's candidates.
+
+    ``cand`` is ``(n_steps, n_candidates, n_clips)``; each candidate pair is read
+    once for all graphs, and problem ``b`` takes clip ``clip_of_problem[b]`` under
+    graph ``graph_of_problem[b]``. Returns ``(n_steps - 1, n_candidates, n_candidates, n_problems)``.
+    """
+    moves = graphs.log_prob_all(layer, cand[:-1, :, None, :], cand[1:, None, :, :])
+    moves = moves.reshape(moves.shape[:3] + (cand.shape[2] * graphs.n_graphs,))
+    column = clip_of_problem * graphs.n_graphs + graph_of_problem
+    if len(column) == moves.shape[3] and (column == np.arange(len(column))).all():
+        return moves  # every graph of every clip, clip after clip: already in order
+    return np.take(moves, column, axis=3)
 
 
 def _candidates(tree, graphs, depth, beam, graph_of_problem, node_prior):
@@ -231,7 +251,7 @@ def _descend(tree, graphs, frames, pos, pad, graph_of_problem, *, layer, n_paths
 
 
 def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, *, layer, n_paths=5,
-                node_prior="graph", guide=None, normalise=True):
+                node_prior="graph", guide=None, normalise=True, prune=False):
     """Top-down beam Viterbi: the best node sequences of clips under graphs, layer by layer.
 
     Every frame starts at the root. Going one layer down, a frame's candidates
@@ -264,6 +284,17 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         graph only runs the last K-best pass on the candidates this shared
         beam leaves: much faster with many graphs, and the same with a wide
         beam. By default each problem searches under its own graph.
+    normalise : bool, default=True
+        Score with ``log Ps``; without, with ``log Po`` (rankings within a
+        problem are the same; across the graphs of a clip too when the
+        normaliser is shared, ``node_prior="layer"``).
+    prune : bool, default=False
+        Classification only: run the K-best pass only on the problems that may
+        hold the highest summed score of their clip. The sum of ``n_paths``
+        sequences lies between the best one and ``n_paths`` times it, so a
+        problem whose best sequence scores more than ``log(n_paths)`` below
+        the best sequence of another problem of the same clip can never win;
+        it gets ``-inf`` scores and -1 paths. Which problem wins is unchanged.
 
     Returns
     -------
@@ -298,6 +329,7 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         scores = np.full((n_problems, n_paths), -np.inf)
         scores[:, 0] = 0.0
         return paths, scores
+    moves = None
     if guide is None:
         beam = _descend(tree, graphs, frames[used], pos, pad, graph_of_problem, layer=layer - 1,
                         n_paths=n_paths, node_prior=node_prior)
@@ -312,11 +344,34 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         if node_prior == "layer":  # the same candidates and emissions for every graph of a clip
             cand, allowed = _candidates(tree, graphs, layer, beam, first, node_prior)
             emit = _emissions(tree, layer, frames[clip_used], clip_pos, cand, first, allowed, normalise)
+            moves = _shared_moves(graphs, layer, cand, inverse, graph_of_problem)
             cand, emit = cand[:, :, inverse], emit[:, :, inverse]
         else:
             cand, allowed = _candidates(tree, graphs, layer, beam[:, :, inverse], graph_of_problem, node_prior)
             emit = _emissions(tree, layer, frames[used], pos, cand, graph_of_problem, allowed, normalise)
-    slots, scores = kbest_viterbi(*_trellis(graphs, layer, cand, emit, graph_of_problem, pad), n_paths)
+    initial, steps = _trellis(graphs, layer, cand, emit, graph_of_problem, pad, moves)
+    if prune and n_paths > 1:
+        return _pruned_kbest(initial, steps, cand, clip_of_problem, n_paths)
+    return _paths(cand, *kbest_viterbi(initial, steps, n_paths))
+
+
+def _pruned_kbest(initial, steps, cand, clip_of_problem, n_paths):
+    """:func:`kbest_viterbi` on the problems that may win their clip; -inf for the others."""
+    best = best_scores(initial, steps)
+    clips, inverse = np.unique(clip_of_problem, return_inverse=True)
+    top = np.full(len(clips), -np.inf)
+    np.maximum.at(top, inverse, best)
+    # Kept with a margin for rounding in the sums of n_paths terms.
+    live = np.flatnonzero(best + np.log(n_paths) >= top[inverse] - 1e-9 * np.abs(top[inverse]))
+    paths = np.full((len(best), n_paths, len(cand)), -1, dtype=np.intp)
+    scores = np.full((len(best), n_paths), -np.inf)
+    slots, live_scores = kbest_viterbi(initial[:, live], steps[..., live], n_paths)
+    paths[live], scores[live] = _paths(cand[..., live], slots, live_scores)
+    return paths, scores
+
+
+def _paths(cand, slots, scores):
+    """Node sequences from the K-best pass's candidate slots."""
     nodes = cand.transpose(2, 0, 1)  # (problem, step, candidate)
     paths = np.take_along_axis(nodes[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
     paths[slots < 0] = -1

@@ -263,11 +263,12 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     # -- decoding ------------------------------------------------------------------
 
-    def _decode(self, clips, graphs, layer, n_graphs, exact=True):
+    def _decode(self, clips, graphs, layer, n_graphs, exact=True, prune=False):
         """Beam-decode every clip under every graph: paths and scores per clip.
 
         Without ``exact``, and when the normaliser of ``Ps`` is the same for
         every graph (``node_prior="layer"``), scores skip it: rankings are equal.
+        With ``prune``, graphs that cannot score a clip best get ``-inf`` (for ``predict``).
         """
         normalise = exact or self.node_prior != "layer"
         # One beam search per clip on the global graph, shared by all graphs. Under
@@ -277,15 +278,16 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         frames, offsets = stack_clips(clips)
         return decode_clips(
             self.tree_, graphs, (frames - self.center_) / self.scale_, offsets, n_graphs=n_graphs, layer=layer,
-            n_paths=self.n_paths, node_prior=self.node_prior, guide=guide, normalise=normalise, n_jobs=self.n_jobs,
+            n_paths=self.n_paths, node_prior=self.node_prior, guide=guide, normalise=normalise, prune=prune, n_jobs=self.n_jobs,
         )
 
-    def _class_log_probs(self, clips, exact=True):
+    def _class_log_probs(self, clips, exact=True, prune=False):
         """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
 
         Without ``exact``, up to a constant per clip (enough to rank classes).
+        With ``prune``, ``-inf`` for classes that provably do not score best.
         """
-        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_), exact)
+        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_), exact, prune)
         per_graph = logsumexp(scores, axis=2)
         if self.graph == "class":
             return per_graph
@@ -338,7 +340,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         labels : ndarray of shape (n_clips,)
         """
         check_is_fitted(self)
-        log_prob = self._class_log_probs(check_clips(X, estimator=self), exact=False)
+        # Classes whose best sequence is too far below another's are left out of the
+        # K-best pass: they cannot win (see beam_decode's prune), so labels are unchanged.
+        log_prob = self._class_log_probs(check_clips(X, estimator=self), exact=False, prune=True)
         return self.classes_[np.argmax(log_prob, axis=1)]
 
     def predict_proba_windows(self, X, width, step=1):

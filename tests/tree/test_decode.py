@@ -133,3 +133,32 @@ def test_the_normaliser_survives_underflow():
     expected = [[logsumexp(log_po[i][allowed[g]]) for g in range(2)] for i in range(2)]
     np.testing.assert_allclose(_log_normaliser(log_po, allowed), expected)
     assert np.isfinite(_log_normaliser(log_po, allowed)).all()
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_pruning_keeps_the_winner_of_every_clip(seed):
+    """Problems left out of the K-best pass provably could not have the highest summed score."""
+    from scipy.special import logsumexp
+
+    from skmotion.tree._decode import _paths, _pruned_kbest
+    from skmotion.tree._viterbi import kbest_viterbi
+
+    rng = np.random.default_rng(seed)
+    n_steps, n_cand, n_clips, n_graphs, n_paths = 6, 4, 5, 4, 3
+    clip_of_problem = np.repeat(np.arange(n_clips), n_graphs)
+    shift = rng.normal(scale=3.0, size=len(clip_of_problem))  # some graphs far behind, some close
+    initial = rng.normal(size=(n_cand, len(shift))) + shift
+    steps = rng.normal(size=(n_steps - 1, n_cand, n_cand, len(shift)))
+    cand = rng.integers(0, 9, size=(n_steps, n_cand, len(shift)))
+    full_paths, full = _paths(cand, *kbest_viterbi(initial, steps, n_paths))
+    paths, pruned = _pruned_kbest(initial, steps, cand, clip_of_problem, n_paths)
+    total, total_full = logsumexp(pruned, axis=1), logsumexp(full, axis=1)
+    live = np.isfinite(total)
+    np.testing.assert_array_equal(pruned[live], full[live])
+    np.testing.assert_array_equal(paths[live], full_paths[live])
+    assert (paths[~live] == -1).all()
+    for c in range(n_clips):
+        rows = clip_of_problem == c
+        assert np.argmax(total[rows]) == np.argmax(total_full[rows])
+        assert (total_full[rows][~live[rows]] < total_full[rows].max()).all()
+    assert (~live).any()  # the case is not trivial

@@ -168,3 +168,57 @@ def test_grid_search_over_depth_and_leaf_size(in_pipeline):
     search = GridSearchCV(model, grid, cv=GroupKFold(3)).fit(X, data.target, groups=data.groups)
     assert len(search.cv_results_["params"]) == 4
     assert search.best_score_ >= 0.8
+
+
+@pytest.fixture(scope="module")
+def marker_search():
+    """A GridSearchCV over depth and leaf size on virtual markers, with its data and folds."""
+    from skmotion.preprocessing import VirtualMarkerTransform
+
+    data = make_motions(n_clips_per_class=4, classes=["walk", "jump", "squat"], duration=(1.0, 1.5),
+                        random_state=3)
+    pipe = make_pipeline(VirtualMarkerTransform(skeleton=data.skeleton, frame_rate=data.frame_rate),
+                         MotionTreeHMM(n_paths=2))
+    grid = {"motiontreehmm__max_depth": [2, 5], "motiontreehmm__min_samples_leaf": [4, 24]}
+    splits = list(GroupKFold(2).split(data.clips, data.target, data.groups))
+    search = GridSearchCV(pipe, grid, cv=splits).fit(data.clips, data.target)
+    return search, data, splits
+
+
+def test_grid_search_on_virtual_markers_equals_a_manual_loop(marker_search):
+    from sklearn.base import clone
+    from sklearn.model_selection import ParameterGrid
+
+    search, data, splits = marker_search
+    X, y = data.clips, data.target
+    manual = []
+    for params in ParameterGrid(search.param_grid):
+        folds = []
+        for train, test in splits:
+            model = clone(search.estimator).set_params(**params).fit([X[i] for i in train], y[train])
+            folds.append(np.mean(model.predict([X[i] for i in test]) == y[test]))
+        manual.append((params, np.mean(folds)))
+    assert [p for p, _ in manual] == list(search.cv_results_["params"])
+    np.testing.assert_allclose([s for _, s in manual], search.cv_results_["mean_test_score"])
+    best = max(range(len(manual)), key=lambda i: (manual[i][1], -i))  # the first of the best, as sklearn
+    assert search.best_params_ == manual[best][0]
+    # the refit model is the best setting fitted on all clips
+    refit = clone(search.estimator).set_params(**manual[best][0]).fit(X, y)
+    np.testing.assert_array_equal(search.predict(X), refit.predict(X))
+
+
+def test_the_fitted_marker_pipeline_pickles(marker_search):
+    import pickle
+
+    search, data, _ = marker_search
+    restored = pickle.loads(pickle.dumps(search.best_estimator_))
+    np.testing.assert_array_equal(restored.predict(data.clips), search.best_estimator_.predict(data.clips))
+    np.testing.assert_array_equal(restored.predict_proba(data.clips), search.best_estimator_.predict_proba(data.clips))
+    np.testing.assert_array_equal(restored.score_samples(data.clips), search.best_estimator_.score_samples(data.clips))
+
+
+@pytest.mark.parametrize("graph", ["class", "clip"])
+def test_pruned_predict_agrees_with_full_scoring(motions, graph):
+    X, y, _ = motions
+    model = MotionTreeHMM(max_depth=4, n_paths=3, graph=graph).fit(X[::2], y[::2])
+    np.testing.assert_array_equal(model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)])

@@ -63,13 +63,18 @@ def test_a_node_never_left_has_a_uniform_row():
     np.testing.assert_allclose(graphs.matrix(0, 0)[1], [1 / 3] * 3)
 
 
-def test_sparse_lookup_matches_the_dense_table(monkeypatch, rng):
-    labels = rng.integers(0, 7, size=200)
-    args = dict(offsets=[0, 50, 120, 200], graph_of_clip=[0, 1, 1], smoothing=0.3)
-    dense = TransitionGraphs.count([labels], [7], **args)
+def dense_and_sparse(monkeypatch, labels, n_nodes, **args):
+    """The same graphs with a dense log table and with the sparse lookup."""
+    dense = TransitionGraphs.count([labels], [n_nodes], **args)
     monkeypatch.setattr(_transitions, "_DENSE_LIMIT", 0)
-    sparse = TransitionGraphs.count([labels], [7], **args)
+    sparse = TransitionGraphs.count([labels], [n_nodes], **args)
     assert dense._dense[0] is not None and sparse._dense[0] is None
+    return dense, sparse
+
+
+def test_sparse_lookup_matches_the_dense_table(monkeypatch, rng):
+    dense, sparse = dense_and_sparse(monkeypatch, rng.integers(0, 7, size=200), 7, offsets=[0, 50, 120, 200],
+                                     graph_of_clip=[0, 1, 1], smoothing=0.3)
     g, src, dst = rng.integers(0, 2, 300), rng.integers(-1, 8, 300), rng.integers(-1, 8, 300)
     np.testing.assert_array_equal(dense.log_prob(0, g, src, dst), sparse.log_prob(0, g, src, dst))
     assert np.isneginf(dense.log_prob(0, 0, [-1, 7, 2], [3, 3, 7])).all()
@@ -87,3 +92,15 @@ def test_propagate_is_a_matrix_power(rng):
 def test_smoothing_must_be_positive():
     with pytest.raises(ValueError, match="smoothing must be a positive number"):
         TransitionGraphs.count([np.zeros(3, int)], [1], offsets=[0, 3], graph_of_clip=[0], smoothing=0)
+
+
+def test_log_prob_all_reads_every_graph_at_once(monkeypatch, rng):
+    dense, sparse = dense_and_sparse(monkeypatch, rng.integers(0, 6, size=150), 6, offsets=[0, 40, 90, 150],
+                                     graph_of_clip=[0, 1, 2], smoothing=0.7)
+    src, dst = rng.integers(-1, 7, (4, 5)), rng.integers(-1, 7, (4, 5))
+    expected = np.stack([dense.log_prob(0, g, src, dst) for g in range(3)], axis=-1)
+    for graphs in (dense, sparse):
+        np.testing.assert_array_equal(graphs.log_prob_all(0, src, dst), expected)
+    # against the probabilities themselves
+    P = dense.matrix(0, 1)
+    np.testing.assert_allclose(np.exp(dense.log_prob_all(0, [2], [4])[0, 1]), P[2, 4])
