@@ -6,6 +6,7 @@ layer.
 """
 
 import math
+import time
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -117,6 +118,8 @@ class MotionPlan:
         The count in the global graph of every transition of the path (all > 0).
     expansions : int
         States the search expanded.
+    search_seconds : float
+        Wall time of the search alone (root motion and IK excluded).
     channels : ndarray of shape (n_frames, n_channels) or None
         Joint angles by damped least-squares IK, when a skeleton is known.
     skeleton : Skeleton or None
@@ -134,6 +137,7 @@ class MotionPlan:
     body_size: float
     seen_counts: np.ndarray
     expansions: int
+    search_seconds: float = 0.0
     channels: np.ndarray = None
     skeleton: object = None
     ik_rms: np.ndarray = field(default=None, repr=False)
@@ -190,7 +194,7 @@ def _place(model, channels, root, metres_per_unit):
 
 
 def plan_motion(means, transitions, visits, start, goal, *, frame_rate, body_size, max_frames, tolerance,
-                start_node=None, model=None, heuristic_weight=1.0, cell=0.05, heading_bins=36,
+                start_node=None, model=None, heuristic_weight=8.0, cell=0.05, heading_bins=36,
                 max_expansions=500_000, damping=1e-3, layer=-1):
     """Plan a motion on one layer of a motion database; see :meth:`MotionTreeHMM.plan`.
 
@@ -231,16 +235,18 @@ def plan_motion(means, transitions, visits, start, goal, *, frame_rate, body_siz
     else:
         start_costs = np.full(len(means), np.inf)
         start_costs[start_node] = 0.0
+    began = time.perf_counter()
     result = astar_search(
         indptr, indices, costs, steps, start_costs, start, goal, tolerance=tolerance, max_frames=max_frames,
         heuristic_weight=heuristic_weight, cell=cell, heading_bins=heading_bins, max_expansions=max_expansions,
     )
+    search_seconds = time.perf_counter() - began
     nodes = result.nodes
     path_counts = np.asarray(counts[nodes[:-1], nodes[1:]]).ravel()
     plan = MotionPlan(
         nodes=nodes, log_probability=-result.cost, frames=means[nodes], root=result.poses,
         goal=np.asarray(goal, dtype=float), layer=layer, frame_rate=float(frame_rate), body_size=float(body_size),
-        seen_counts=path_counts, expansions=result.expansions,
+        seen_counts=path_counts, expansions=result.expansions, search_seconds=search_seconds,
     )
     if model is not None:
         metres_per_unit = body_size / model.units_per_size

@@ -62,17 +62,44 @@ class SearchResult:
     expansions: int
 
 
-def _successor_lists(indptr, indices, costs, steps):
-    """Per node, a list of (successor, cost) and its own displacement; plain floats for speed."""
-    out = []
+def _graph_lists(indptr, indices, costs, steps, max_dwell, dwell_span):
+    """Per node: its self-loop cost (or None), its other successors, and its dwell displacements.
+
+    ``dwell[m][k - 1]`` is the body-frame displacement after ``k`` frames in
+    node ``m`` (a constant twist, composed exactly), for ``k`` from 1 to
+    ``dwell_span`` times the node's mean dwell ``1 / (1 - p(m -> m))``: a
+    longer stay has probability below ``exp(-dwell_span)``.
+    """
+    loops, moves, dwell = [], [], []
     for m in range(len(indptr) - 1):
-        lo, hi = indptr[m], indptr[m + 1]
-        out.append([(int(n), float(c)) for n, c in zip(indices[lo:hi], costs[lo:hi])])
-    return out, [tuple(map(float, s)) for s in steps]
+        succ = indices[indptr[m]:indptr[m + 1]]
+        cost = costs[indptr[m]:indptr[m + 1]]
+        own = succ == m
+        loops.append(float(cost[own][0]) if own.any() else None)
+        moves.append([(int(n), float(c)) for n, c in zip(succ[~own], cost[~own])])
+        longest = 1
+        if own.any():
+            leave = -math.expm1(-float(cost[own][0]))  # 1 - p(m -> m)
+            longest = max_dwell if leave <= 0 else int(min(max_dwell, math.ceil(dwell_span / leave)))
+        k = np.arange(1, longest + 1)
+        dx, dy, dh = steps[m]
+        dwell.append(_compose(dx, dy, dh, k))
+    return loops, moves, dwell
+
+
+def _compose(dx, dy, dh, k):
+    """``k`` repeats of the planar step ``(dx, dy, dh)``: an arc of the same constant twist."""
+    if abs(dh) < 1e-12:
+        return np.column_stack([k * dx, k * dy, np.zeros(len(k))])
+    # One step is a rotation by dh about a fixed centre c: p -> c + R(dh) (p - c).
+    cx = (dx - dy * math.sin(dh) / (1 - math.cos(dh))) / 2 if abs(1 - math.cos(dh)) > 1e-15 else 0.0
+    cy = (dy + dx * math.sin(dh) / (1 - math.cos(dh))) / 2 if abs(1 - math.cos(dh)) > 1e-15 else 0.0
+    a = k * dh
+    return np.column_stack([cx - (np.cos(a) * cx - np.sin(a) * cy), cy - (np.sin(a) * cx + np.cos(a) * cy), a])
 
 
 def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tolerance, max_frames,
-                 heuristic_weight=1.0, cell=0.05, heading_bins=36, max_expansions=500_000):
+                 heuristic_weight=1.0, cell=0.05, heading_bins=36, max_expansions=500_000, dwell_span=3.0):
     """Search the most probable node path whose root reaches ``goal``; see the module notes.
 
     Parameters
@@ -96,6 +123,9 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
     heading_bins : int, default=36
     max_expansions : int, default=500000
         Give up (as unreachable) after this many expansions.
+    dwell_span : float, default=3.0
+        The longest stay in a node, in multiples of its mean stay
+        ``1 / (1 - p_self)``.
 
     Returns
     -------
@@ -119,7 +149,6 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
     >>> r.nodes.tolist(), r.poses[-1].round(6).tolist()
     ([0, 0, 0, 0, 0, 1, 1, 1, 1], [0.5, 0.3, 0.0])
     """
-    succ, step = _successor_lists(indptr, indices, costs, steps)
     gx, gy = float(goal[0]), float(goal[1])
     tol = float(tolerance)
     lengths = np.hypot(steps[:, 0], steps[:, 1])
@@ -130,6 +159,7 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
     moving = lengths[src] > 0
     r = float((seen_costs[moving] / lengths[src][moving]).min()) if moving.any() else 0.0
     w = float(heuristic_weight)
+    loops, moves, dwell = _graph_lists(indptr, indices, costs, steps, max_frames, dwell_span)
 
     def frames_needed(d):
         if d <= tol:
@@ -148,59 +178,97 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
             f"{s_max * (max_frames - 1):.3f} m in max_frames={max_frames} frames.", closest=d0,
         )
     two_pi = 2.0 * math.pi
-    key_of = lambda n, x, y, h: (n, round(x / cell), round(y / cell), int((h % two_pi) / two_pi * heading_bins))  # noqa: E731
-    nodes, poses, parents, frames, gs = [], [], [], [], []
+
+    def key_of(n, x, y, h):
+        return (n, int(np.rint(x / cell)), int(np.rint(y / cell)), int((h % two_pi) / two_pi * heading_bins))
+
+    # A search node enters graph node n at frame t with pose (x, y, h) and cost g; expanding it
+    # chooses how many frames to dwell in n (self-loops) and the next node. A terminal entry
+    # (n = -1) is a path that ends inside its last dwell, at the goal.
+    nodes, poses, parents, frames, gs, dwells = [], [], [], [], [], []
     heap, best = [], {}
-    counter = 0
+
+    def push(n, pose, parent, t, g, f, k=0):
+        nodes.append(n); poses.append(pose); parents.append(parent); frames.append(t); gs.append(g); dwells.append(k)
+        heapq.heappush(heap, (f, len(nodes) - 1))
+
     for n in np.flatnonzero(np.isfinite(start_costs)):
-        g = float(start_costs[n])
-        nodes.append(int(n)); poses.append(tuple(map(float, start))); parents.append(-1); frames.append(0); gs.append(g)
-        heapq.heappush(heap, (g + heuristic(d0), counter, len(nodes) - 1))
-        counter += 1
+        push(int(n), tuple(map(float, start)), -1, 0, float(start_costs[n]), float(start_costs[n]) + heuristic(d0))
     closest, expansions, found = d0, 0, -1
     while heap:
-        _, _, i = heapq.heappop(heap)
-        n, (x, y, h), g, t = nodes[i], poses[i], gs[i], frames[i]
+        _, i = heapq.heappop(heap)
+        n, g, t = nodes[i], gs[i], frames[i]
+        if n < 0:
+            found = i
+            break
+        x, y, h = poses[i]
         key = key_of(n, x, y, h)
         if best.get(key, math.inf) < g:
             continue
         best[key] = g
-        d = math.hypot(gx - x, gy - y)
-        closest = min(closest, d)
-        if d <= tol:
-            found = i
-            break
         expansions += 1
         if expansions > max_expansions:
             break
-        dx, dy, dh = step[n]
+        # Every dwell of k frames in n at once: poses of its frames t .. t + k - 1 and after it.
+        room = max_frames - t
+        table = dwell[n][:room]
         c, s = math.cos(h), math.sin(h)
-        nx, ny, nh = x + c * dx - s * dy, y + s * dx + c * dy, h + dh
-        nd = math.hypot(gx - nx, gy - ny)
-        if t + 1 + frames_needed(nd) >= max_frames:
+        px = np.concatenate([[x], x + c * table[:, 0] - s * table[:, 1]])
+        py = np.concatenate([[y], y + s * table[:, 0] + c * table[:, 1]])
+        ph = np.concatenate([[h], h + table[:, 2]])
+        dist = np.hypot(gx - px, gy - py)
+        closest = min(closest, float(dist.min()))
+        loop = loops[n] if loops[n] is not None else math.inf
+        at_goal = np.flatnonzero(dist[: len(table)] <= tol) if loops[n] is not None else np.flatnonzero(dist[:1] <= tol)
+        if len(at_goal):
+            j = int(at_goal[0])  # end at frame t + j, after j self-loops
+            push(-1, (float(px[j]), float(py[j]), float(ph[j])), i, t + j, g + j * loop, g + j * loop, j + 1)
+        # All dwells at once: the frame after, the lower bound still to go, the cell keys.
+        ks = np.arange(1, len(table) + 1)
+        dk = dist[1:]
+        need = np.where(dk <= tol, 0, np.ceil((dk - tol) / s_max - 1e-12)) if s_max > 0 else np.where(dk <= tol, 0, np.inf)
+        ok = np.flatnonzero(t + ks + need < max_frames)
+        if not len(ok) or not moves[n]:
             continue
-        hh = heuristic(nd)
-        for m, cost in succ[n]:
-            ng = g + cost
-            if best.get(key_of(m, nx, ny, nh), math.inf) <= ng:
-                continue
-            nodes.append(m); poses.append((nx, ny, nh)); parents.append(i); frames.append(t + 1); gs.append(ng)
-            heapq.heappush(heap, (ng + hh, counter, len(nodes) - 1))
-            counter += 1
+        hk = np.where(dk <= tol, 0.0, w * np.maximum(c_min * need, r * (dk - tol)))
+        ix = np.rint(px[1:] / cell).astype(np.int64).tolist()
+        iy = np.rint(py[1:] / cell).astype(np.int64).tolist()
+        ih = ((ph[1:] % two_pi) / two_pi * heading_bins).astype(np.int64).tolist()
+        hk = hk.tolist()
+        for j in ok.tolist():
+            base = g + j * loop
+            pose = None
+            for m, cost in moves[n]:
+                ng = base + cost
+                if best.get((m, ix[j], iy[j], ih[j]), math.inf) <= ng:
+                    continue
+                if pose is None:
+                    pose = (float(px[j + 1]), float(py[j + 1]), float(ph[j + 1]))
+                push(m, pose, i, t + j + 1, ng, ng + hk[j], j + 1)
     if found < 0:
         why = f"gave up after max_expansions={max_expansions} expansions" if heap else "every path was explored"
         raise UnreachableGoalError(
             f"no path of the transition graph takes the root within {tol:g} m of the goal in max_frames={max_frames} "
             f"frames ({why}); the closest approach was {closest:.3f} m.", closest=closest,
         )
+    # Unroll: each entry dwelt dwells[child] frames in its node before the child's node.
     chain = []
     while found >= 0:
         chain.append(found)
         found = parents[found]
     chain.reverse()
+    out_nodes, out_poses = [], []
+    for a, b in zip(chain[:-1], chain[1:]):
+        k = dwells[b]
+        x, y, h = poses[a]
+        table = np.vstack([[0.0, 0.0, 0.0], dwell[nodes[a]][: k - 1]])
+        c, s = math.cos(h), math.sin(h)
+        out_nodes += [nodes[a]] * k
+        out_poses.append(np.column_stack([x + c * table[:, 0] - s * table[:, 1], y + s * table[:, 0] + c * table[:, 1],
+                                          h + table[:, 2]]))
     return SearchResult(
-        nodes=np.array([nodes[i] for i in chain], dtype=np.intp),
-        poses=np.array([poses[i] for i in chain]),
+        nodes=np.array(out_nodes, dtype=np.intp),
+        poses=np.vstack(out_poses),
         cost=gs[chain[-1]],
         expansions=expansions,
     )

@@ -440,7 +440,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         )
 
     def plan(self, start, goal, *, frame_rate, body_size=None, transformer=None, layer=None, max_frames=300,
-             tolerance=0.1, start_node=None, heuristic_weight=1.0, cell=0.05, heading_bins=36,
+             tolerance=0.1, start_node=None, heuristic_weight=8.0, cell=0.05, heading_bins=36,
              max_expansions=500_000):
         """Plan a motion on the global transition graph that takes the root from ``start`` to ``goal``.
 
@@ -484,8 +484,10 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         start_node : int, default=None
             The node of the first frame; None lets the search choose (costed
             by the node's share of the training frames).
-        heuristic_weight : float, default=1.0
-            Weighted A*: the path's cost is at most this times the optimum.
+        heuristic_weight : float, default=8.0
+            Weighted A*: the path's cost is at most this times the optimum
+            (1 is plain A*, optimal but slow: its lower bound of the cost
+            still to go is weak, see :func:`~skmotion.planning.astar_search`).
         cell, heading_bins : float, int, default=0.05, 36
             Poses closer than this (metres, heading bins) are one search state.
         max_expansions : int, default=500000
