@@ -16,6 +16,7 @@ SECTIONS = (
     "skmotion._demo.recognition",
     "skmotion._demo.index",
     "skmotion._demo.primitives",
+    "skmotion._demo.planning",
 )
 
 
