@@ -43,6 +43,17 @@ def plan_axes(up_axis):
     return t
 
 
+def damped_solve(jtj, jtv, damping):
+    """``(J^T J + lambda^2 I)^-1 J^T v``, batched, with ``lambda^2 = damping^2 * mean diag(J^T J)``.
+
+    Scaling the damping by the mean of the diagonal makes it unit-free: 1e-3
+    changes a well-conditioned solution by about one part in a million.
+    """
+    k = jtj.shape[-1]
+    scale = np.trace(jtj, axis1=-2, axis2=-1)[..., None, None] / k
+    return np.linalg.solve(jtj + damping**2 * scale * np.eye(k), jtv[..., None])[..., 0]
+
+
 def marker_jacobian(skeleton, markers, channels, columns, *, eps=1e-6):
     """Marker positions and their derivatives with respect to some channels, for many poses.
 
@@ -124,14 +135,11 @@ def damped_ik(skeleton, markers, targets, initial, *, damping=1e-2, n_iter=30, t
     """
     q = np.array(initial, dtype=float)
     columns = np.arange(skeleton.n_channels)
-    eye = np.eye(len(columns))
     for _ in range(n_iter):
         pos, jac = marker_jacobian(skeleton, markers, q, columns)
         jac = jac.reshape(len(q), -1, len(columns))
         err = (targets - pos).reshape(len(q), -1)
-        jtj = np.einsum("nji,njk->nik", jac, jac)
-        scale = np.trace(jtj, axis1=1, axis2=2)[:, None, None] / len(columns)
-        step = np.linalg.solve(jtj + damping**2 * scale * eye, np.einsum("nji,nj->ni", jac, err)[..., None])[..., 0]
+        step = damped_solve(np.einsum("nji,njk->nik", jac, jac), np.einsum("nji,nj->ni", jac, err), damping)
         q += step
         if np.abs(step).max() < tol:
             break

@@ -20,20 +20,9 @@ part is what remains.
 
 import numpy as np
 
-from skmotion.planning._ik import marker_jacobian, plan_axes
+from skmotion.planning._ik import damped_solve, marker_jacobian, plan_axes
 
 __all__ = ["planar_step", "rigid_root_velocity", "skeleton_root_velocity"]
-
-
-def _damped_solve(jtj, jtv, damping):
-    """``(J^T J + lambda^2 I)^-1 J^T v``, batched, with ``lambda^2 = damping^2 * mean diag(J^T J)``.
-
-    Scaling the damping by the mean of the diagonal makes it unit-free: 1e-3
-    changes a well-conditioned solution by about one part in a million.
-    """
-    k = jtj.shape[-1]
-    scale = np.trace(jtj, axis1=-2, axis2=-1)[..., None, None] / k
-    return np.linalg.solve(jtj + damping**2 * scale * np.eye(k), jtv[..., None])[..., 0]
 
 
 def rigid_root_velocity(positions, velocities, *, damping=1e-3):
@@ -72,7 +61,7 @@ def rigid_root_velocity(positions, velocities, *, damping=1e-3):
     # J^T J and J^T v of the rows [1, 0, -p_y] and [0, 1, p_x], summed over the markers.
     jtj = np.stack([np.stack([m, zero, -sy], -1), np.stack([zero, m, sx], -1), np.stack([-sy, sx, r2], -1)], -2)
     jtv = np.stack([vx.sum(axis=1), vy.sum(axis=1), (px * vy - py * vx).sum(axis=1)], axis=-1)
-    return _damped_solve(jtj, jtv, damping)
+    return damped_solve(jtj, jtv, damping)
 
 
 def skeleton_root_velocity(skeleton, markers, channels, velocities, *, damping=1e-3):
@@ -131,7 +120,7 @@ def skeleton_root_velocity(skeleton, markers, channels, velocities, *, damping=1
     full = np.concatenate([twist, jac], axis=-1).reshape(n, 3 * m, -1)
     jtj = np.einsum("nji,njk->nik", full, full)
     jtv = np.einsum("nji,nj->ni", full, velocities.reshape(n, -1))
-    u = _damped_solve(jtj, jtv, damping)
+    u = damped_solve(jtj, jtv, damping)
     # The yaw column turns about the root marker, the body frame about the point
     # below it on the floor: the same planar motion, as the two share x and y.
     return u[:, [0, 1, 5]]
