@@ -122,7 +122,8 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
     cell : float, default=0.05
     heading_bins : int, default=36
     max_expansions : int, default=500000
-        Give up (as unreachable) after this many expansions.
+        After this many expansions, return the cheapest path to the goal found
+        so far, or give up (as unreachable) when there is none.
     dwell_span : float, default=3.0
         The longest stay in a node, in multiples of its mean stay
         ``1 / (1 - p_self)``.
@@ -194,7 +195,7 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
 
     for n in np.flatnonzero(np.isfinite(start_costs)):
         push(int(n), tuple(map(float, start)), -1, 0, float(start_costs[n]), float(start_costs[n]) + heuristic(d0))
-    closest, expansions, found = d0, 0, -1
+    closest, expansions, found, fallback = d0, 0, -1, -1
     while heap:
         _, i = heapq.heappop(heap)
         n, g, t = nodes[i], gs[i], frames[i]
@@ -208,6 +209,9 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
         best[key] = g
         expansions += 1
         if expansions > max_expansions:
+            # Out of budget: the cheapest path found so far that ends at the goal, if any
+            # (it reaches the goal on seen transitions, but its cost is not proven minimal).
+            found = fallback
             break
         # Every dwell of k frames in n at once: poses of its frames t .. t + k - 1 and after it.
         room = max_frames - t
@@ -223,6 +227,8 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
         if len(at_goal):
             j = int(at_goal[0])  # end at frame t + j, after j self-loops
             push(-1, (float(px[j]), float(py[j]), float(ph[j])), i, t + j, g + j * loop, g + j * loop, j + 1)
+            if fallback < 0 or gs[-1] < gs[fallback]:
+                fallback = len(nodes) - 1
         # All dwells at once: the frame after, the lower bound still to go, the cell keys.
         ks = np.arange(1, len(table) + 1)
         dk = dist[1:]
@@ -231,10 +237,15 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
         if not len(ok) or not moves[n]:
             continue
         hk = np.where(dk <= tol, 0.0, w * np.maximum(c_min * need, r * (dk - tol)))
-        ix = np.rint(px[1:] / cell).astype(np.int64).tolist()
-        iy = np.rint(py[1:] / cell).astype(np.int64).tolist()
-        ih = ((ph[1:] % two_pi) / two_pi * heading_bins).astype(np.int64).tolist()
-        hk = hk.tolist()
+        ix = np.rint(px[1:] / cell).astype(np.int64)
+        iy = np.rint(py[1:] / cell).astype(np.int64)
+        ih = ((ph[1:] % two_pi) / two_pi * heading_bins).astype(np.int64)
+        # A longer dwell ending in the same cell as a shorter one costs more and would be
+        # merged into it: only the first dwell into each cell is worth a push.
+        fresh = np.ones(len(ix), dtype=bool)
+        fresh[1:] = (np.diff(ix) != 0) | (np.diff(iy) != 0) | (np.diff(ih) != 0)
+        ok = ok[fresh[ok]]
+        ix, iy, ih, hk = ix.tolist(), iy.tolist(), ih.tolist(), hk.tolist()
         for j in ok.tolist():
             base = g + j * loop
             pose = None

@@ -491,7 +491,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         cell, heading_bins : float, int, default=0.05, 36
             Poses closer than this (metres, heading bins) are one search state.
         max_expansions : int, default=500000
-            The search gives up after this many states.
+            After this many states the search returns the cheapest path to
+            the goal it has found, or raises when it has found none.
 
         Returns
         -------
