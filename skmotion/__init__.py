@@ -20,6 +20,7 @@ _SUBPACKAGES = (
     "preprocessing",
     "utils",
     "tree",
+    "planning",
 )
 
 __all__ = ["__version__", *_SUBPACKAGES]

@@ -18,6 +18,7 @@ SECTIONS = (
     "skmotion._demo.primitives",
     "skmotion._demo.evaluation",
     "skmotion._demo.checks",
+    "skmotion._demo.planning",
 )
 
 

@@ -12,9 +12,11 @@ from skmotion.datasets._motion_files import (
 from skmotion.datasets._repeats import make_repeated_motions
 from skmotion.datasets._synthetic import MOTION_CLASSES, make_motions
 from skmotion.datasets._uea import load_uea
+from skmotion.datasets._walks import WALK_DIRECTIONS, make_walks
 
 __all__ = [
     "MOTION_CLASSES",
+    "WALK_DIRECTIONS",
     "fetch_cmu_mocap",
     "get_data_home",
     "humanoid_skeleton",
@@ -24,5 +26,6 @@ __all__ = [
     "load_uea",
     "make_motions",
     "make_repeated_motions",
+    "make_walks",
     "read_cmu_index",
 ]

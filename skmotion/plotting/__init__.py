@@ -5,6 +5,7 @@ cheap and works without it.
 """
 
 from ._neighbors import plot_pruning_recall
+from ._planning import plot_plan
 from ._primitives import plot_eigenmovements
 from ._tree import plot_motion_tree_layer, plot_motion_tree_layers, plot_motion_tree_profile
 
@@ -13,5 +14,6 @@ __all__ = [
     "plot_motion_tree_layer",
     "plot_motion_tree_layers",
     "plot_motion_tree_profile",
+    "plot_plan",
     "plot_pruning_recall",
 ]

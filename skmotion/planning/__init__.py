@@ -1,0 +1,23 @@
+"""Motion planning on a motion database's transition graph, root motion recovery and IK (paper 000, V-C)."""
+
+from skmotion.planning._ik import damped_ik, facing_pose, marker_jacobian, plan_axes
+from skmotion.planning._plan import MotionPlan, SkeletonModel, node_root_velocity, plan_motion
+from skmotion.planning._root_motion import planar_step, rigid_root_velocity, skeleton_root_velocity
+from skmotion.planning._search import SearchResult, UnreachableGoalError, astar_search
+
+__all__ = [
+    "MotionPlan",
+    "SearchResult",
+    "SkeletonModel",
+    "UnreachableGoalError",
+    "astar_search",
+    "damped_ik",
+    "facing_pose",
+    "marker_jacobian",
+    "node_root_velocity",
+    "plan_axes",
+    "plan_motion",
+    "planar_step",
+    "rigid_root_velocity",
+    "skeleton_root_velocity",
+]
