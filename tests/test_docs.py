@@ -12,6 +12,8 @@ ROOT = Path(__file__).resolve().parents[1]
 PAGES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 # A block that reads ../shared/data carries this comment; it runs when the data is there.
 NEEDS_DATA = "# doc: needs ../shared/data"
+# A block that imports an optional extra names its module; it runs when that is installed.
+NEEDS_MODULE = re.compile(r"^# doc: needs module (\S+)$", flags=re.M)
 
 
 def _python_blocks(path):
@@ -32,6 +34,8 @@ def test_python_examples_run(page, tmp_path, monkeypatch):
     monkeypatch.chdir(work)
     namespace = {}
     for block in blocks:
+        for module in NEEDS_MODULE.findall(block):
+            pytest.importorskip(module, reason=f"{page.name} needs the optional {module}")
         exec(compile(block, str(page), "exec"), namespace)
 
 
