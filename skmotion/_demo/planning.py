@@ -1,7 +1,6 @@
 """Demo section: planning a walk to a goal on the transition graph (paper 000, V-C, Figure 13)."""
 
-from pathlib import Path
-
+from skmotion._demo._figures import save_figure
 from skmotion.datasets import make_walks
 from skmotion.io import as_motions
 from skmotion.planning import UnreachableGoalError
@@ -36,20 +35,8 @@ def run(context):
     except UnreachableGoalError as exc:
         lines.append(f"goal 30 m ahead within 120 frames: unreachable, {exc}")
     if getattr(context, "plot_dir", None):
-        lines += _plot(plan, context.plot_dir)
+        lines += save_figure(
+            context.plot_dir, "planned_root_path.png", lambda plotting: plotting.plot_plan(plan),
+            "the planned root path and the goal (Figure 13 left)",
+        )
     return lines
-
-
-def _plot(plan, plot_dir):
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-    except ImportError:
-        return ['plots: matplotlib is not installed (pip install "skmotion[plot]")']
-    from skmotion.plotting import plot_plan
-
-    path = Path(plot_dir) / "planned_root_path.png"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    plot_plan(plan).savefig(path, dpi=100)
-    return [f"plot: the planned root path and the goal (Figure 13 left) -> {path}"]

@@ -1,9 +1,8 @@
 """Demo section: recognising motions, estimating the state and predicting it with MotionTreeHMM."""
 
-from pathlib import Path
-
 import numpy as np
 
+from skmotion._demo._figures import save_figure
 from skmotion.tree import MotionTreeHMM
 
 TITLE = "Recognition: the motion database (MotionTreeHMM)"
@@ -16,22 +15,6 @@ def _confusion(names, truth, predicted):
         row = [int(np.sum((truth == name) & (predicted == other))) for other in names]
         lines.append(f"  {name.rjust(width)} " + " ".join(str(v).rjust(5) for v in row))
     return lines
-
-
-def _plots(model, plot_dir):
-    try:
-        import matplotlib
-
-        matplotlib.use("Agg")
-    except ImportError:
-        return ['plots: matplotlib is not installed (pip install "skmotion[plot]")']
-    from skmotion.plotting import plot_motion_tree_layers
-
-    path = Path(plot_dir) / "motion_tree_layers.png"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig = plot_motion_tree_layers(model.tree_, model.global_graph_)
-    fig.savefig(path, dpi=100)
-    return [f"plot: nodes on the first principal axes with the global transition graph -> {path}"]
 
 
 def _split(data, names):
@@ -83,7 +66,11 @@ def run(context):
     ]
     plot_dir = getattr(context, "plot_dir", None)
     if plot_dir:
-        lines += _plots(model, plot_dir)
+        lines += save_figure(
+            plot_dir, "motion_tree_layers.png",
+            lambda plotting: plotting.plot_motion_tree_layers(model.tree_, model.global_graph_),
+            "nodes on the first principal axes with the global transition graph",
+        )
     else:
         lines.append("(skmotion demo --plots DIR draws the tree's nodes and transition graphs, as the paper's Figures 3-5)")
     return lines
