@@ -38,7 +38,10 @@ class MotionTags:
     requires_skeleton : bool, default=False
         Whether the estimator needs a ``Skeleton`` to interpret its input.
     min_frames : int, default=1
-        The fewest frames per clip the estimator accepts with default parameters.
+        The fewest frames per clip the estimator accepts (with its current
+        parameters when the tags are computed from them). ``check_clips`` reads
+        it when called with ``estimator=`` and no ``min_frames``, so an estimator
+        states its minimum in one place.
     """
 
     variable_length: bool = True

@@ -122,7 +122,8 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
         "normalize": ["boolean"],
         "random_state": ["random_state"],
     }
-    _motion_tags = MotionTags(output_kind="table")
+    # A clip without segments has no codes: empty code arrays are valid input.
+    _motion_tags = MotionTags(output_kind="table", min_frames=0)
 
     def __init__(self, n_clusters=30, *, n_init=10, max_iter=300, tol=1e-4, normalize=True, random_state=None):
         self.n_clusters = n_clusters
@@ -133,7 +134,7 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
         self.random_state = random_state
 
     def _codes(self, X, reset=False):
-        return check_clips(X, estimator=self, reset=reset, min_frames=0)
+        return check_clips(X, estimator=self, reset=reset)
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None):

@@ -225,7 +225,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
     # -- fitting -----------------------------------------------------------------------
 
     def _fit(self, X):
-        clips = check_clips(X, estimator=self, reset=True, min_frames=self._min_frames())
+        clips = check_clips(X, estimator=self, reset=True)
         segments = self._segment_all(clips)
         per_clip = self._vectors_all(clips, segments)
         vectors = np.concatenate(per_clip)
@@ -310,7 +310,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
             in the order of the rows of :meth:`transform`.
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        clips = check_clips(X, estimator=self)
         return self._segment_all(clips)
 
     def segment_vectors(self, X):
@@ -327,7 +327,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
             Per clip, one row per segment, channel after channel.
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        clips = check_clips(X, estimator=self)
         return self._vectors_all(clips, self._segment_all(clips))
 
     def transform(self, X):
@@ -344,7 +344,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
             One array per clip, a row per segment (see :meth:`segment`).
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        clips = check_clips(X, estimator=self)
         return [self._encode(v) for v in self._vectors_all(clips, self._segment_all(clips))]
 
     def inverse_transform(self, codes, segments=None, n_frames=None):
@@ -412,7 +412,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
             In the container kind of ``X``; frames outside every segment are NaN.
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        clips = check_clips(X, estimator=self)
         return to_container(self._reconstruct(clips), clips.container)
 
     def score(self, X, y=None):
@@ -434,7 +434,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
             ``-sqrt(mean((x - x_rebuilt) ** 2))``; higher is better.
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self, min_frames=self._min_frames())
+        clips = check_clips(X, estimator=self)
         diff = np.concatenate([c - r for c, r in zip(clips, self._reconstruct(clips))])
         covered = ~np.isnan(diff)
         if not covered.any():

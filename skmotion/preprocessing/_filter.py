@@ -186,7 +186,7 @@ class LowPassFilter(ClipTransformerMixin, BaseEstimator):
         self : LowPassFilter
             The fitted transformer.
         """
-        check_clips(X, estimator=self, reset=True, min_frames=filter_min_frames(self.order, self.cutoff))
+        check_clips(X, estimator=self, reset=True)
         return self
 
     def transform(self, X):
@@ -203,7 +203,7 @@ class LowPassFilter(ClipTransformerMixin, BaseEstimator):
             Filtered clips, in the container kind of ``X``.
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self, min_frames=filter_min_frames(self.order, self.cutoff))
+        clips = check_clips(X, estimator=self)
         out = parallel_map(
             lambda c: lowpass_filter(c, order=self.order, cutoff=self.cutoff), clips, n_jobs=self.n_jobs
         )

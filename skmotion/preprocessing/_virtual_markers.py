@@ -275,7 +275,7 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         self : VirtualMarkerTransform
             The fitted transformer.
         """
-        clips = check_clips(X, estimator=self, reset=True, min_frames=2)
+        clips = check_clips(X, estimator=self, reset=True)
         _, names = self._plans(X, clips)
         self._indices(names)
         self.marker_names_ = np.asarray(names, dtype=object)
@@ -297,7 +297,7 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
             ``set_output(transform="pandas")``).
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self, min_frames=2)
+        clips = check_clips(X, estimator=self)
         plans, names = self._plans(X, clips)
         if list(names) != list(self.marker_names_):
             raise ValueError("X: the clips' markers differ from those seen in fit.")

@@ -208,7 +208,7 @@ def check_clips(
     estimator=None,
     reset=False,
     allow_nan=False,
-    min_frames=1,
+    min_frames=None,
     min_clips=1,
     dtype=(np.float64, np.float32),
     copy=False,
@@ -230,9 +230,11 @@ def check_clips(
         Whether this is the call of ``fit``.
     allow_nan : bool, default=False
         Whether NaN (a missing value) is allowed. Infinity never is.
-    min_frames : int, default=1
+    min_frames : int, default=None
         The fewest frames a clip may have. ``0`` accepts empty clips of shape
         ``(0, n_channels)`` (sequences of segment codes of clips without segments).
+        None takes the ``min_frames`` of the estimator's :class:`~skmotion.base.MotionTags`
+        (so an estimator states its minimum once), and 1 without an estimator.
     min_clips : int, default=1
         The fewest clips the collection may have.
     dtype : dtype or tuple of dtypes, default=(np.float64, np.float32)
@@ -271,6 +273,9 @@ def check_clips(
     """
     dtypes = _normalise_dtypes(dtype)
     name = _estimator_name(estimator)
+    if min_frames is None:
+        tags = getattr(estimator, "__skmotion_tags__", None)
+        min_frames = tags().min_frames if tags is not None else 1
     feature_source = X
     if isinstance(X, pd.DataFrame):
         raw, container = _collection_from_dataframe(X, input_name)

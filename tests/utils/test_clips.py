@@ -284,3 +284,18 @@ def test_empty_clips_only_when_min_frames_is_zero():
     assert clips.lengths.tolist() == [0, 2] and clips.n_channels == 3
     with pytest.raises(ValueError, match="clip 0 has no frames"):
         check_clips(codes)
+
+
+def test_min_frames_defaults_to_the_estimators_tags():
+    from skmotion.base import ClipEstimatorMixin, MotionTags
+
+    class NeedsFive(ClipEstimatorMixin):
+        _motion_tags = MotionTags(min_frames=5)
+
+    clips = [np.zeros((6, 2)), np.zeros((4, 2))]
+    with pytest.raises(ValueError, match="clip 1 has 4 frame"):
+        check_clips(clips, estimator=NeedsFive())
+    # an explicit minimum wins over the tags; without an estimator the minimum is 1
+    assert len(check_clips(clips, estimator=NeedsFive(), min_frames=4)) == 2
+    with pytest.raises(ValueError, match="clip 0 has no frames"):
+        check_clips([np.zeros((0, 2))])
