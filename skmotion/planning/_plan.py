@@ -48,9 +48,8 @@ class SkeletonModel:
     def from_transformer(cls, transformer):
         """The model of a fitted :class:`VirtualMarkerTransform` with a skeleton."""
         skeleton = transformer.skeleton
-        markers = transformer._marker_set(skeleton)
-        names = list(transformer.marker_names_)
-        root, left, right, chain = transformer._indices(names)
+        markers = transformer.marker_set(skeleton)
+        root, (left, right), chain = transformer.root_index_, transformer.facing_indices_, transformer.size_indices_
         size = 1.0
         if chain is not None:
             size = chain_size(markers.positions(skeleton, np.zeros((1, skeleton.n_channels))), chain)

@@ -93,6 +93,12 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         The output markers, in order.
     n_markers_ : int
         Number of markers; the output has ``6 * n_markers_`` channels.
+    root_index_ : int
+        Index in ``marker_names_`` of ``root_marker``.
+    facing_indices_ : tuple of int
+        Indices of the left and right ``facing_markers``.
+    size_indices_ : list of int or None
+        Indices of the ``size_markers`` chain; None without size normalisation.
 
     See Also
     --------
@@ -181,7 +187,26 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
                 sources.append((self.skeleton, float(self.frame_rate)))
         return sources
 
-    def _marker_set(self, skeleton):
+    def marker_set(self, skeleton):
+        """The markers this transformer places on ``skeleton``.
+
+        Parameters
+        ----------
+        skeleton : Skeleton
+
+        Returns
+        -------
+        markers : MarkerSet
+            ``markers`` itself when it is a MarkerSet or a list of markers;
+            otherwise the preset for ``skeleton``.
+
+        Examples
+        --------
+        >>> from skmotion.datasets import humanoid_skeleton
+        >>> from skmotion.preprocessing import VirtualMarkerTransform
+        >>> len(VirtualMarkerTransform().marker_set(humanoid_skeleton()))
+        32
+        """
         if isinstance(self.markers, MarkerSet):
             return self.markers
         if isinstance(self.markers, (list, tuple)):
@@ -231,7 +256,7 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
                         f"X: clip {i} has {clips.n_channels} channels, but its skeleton has {skeleton.n_channels}."
                     )
                 if skeleton not in resolved:
-                    markers = self._marker_set(skeleton)
+                    markers = self.marker_set(skeleton)
                     markers.joint_indices(skeleton)  # every marker's joint exists
                     resolved[skeleton] = markers
                 markers = resolved[skeleton]
@@ -277,7 +302,8 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         """
         clips = check_clips(X, estimator=self, reset=True)
         _, names = self._plans(X, clips)
-        self._indices(names)
+        self.root_index_, left, right, self.size_indices_ = self._indices(names)
+        self.facing_indices_ = (left, right)
         self.marker_names_ = np.asarray(names, dtype=object)
         self.n_markers_ = len(names)
         return self
@@ -301,7 +327,7 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         plans, names = self._plans(X, clips)
         if list(names) != list(self.marker_names_):
             raise ValueError("X: the clips' markers differ from those seen in fit.")
-        root, left, right, chain = self._indices(names)
+        root, (left, right), chain = self.root_index_, self.facing_indices_, self.size_indices_
 
         def one(i):
             skeleton, markers, frame_rate = plans[i]

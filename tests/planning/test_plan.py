@@ -105,7 +105,7 @@ def test_bvh_export_reproduces_the_planned_markers(walk_database, tmp_path):
     path = tmp_path / "plan.bvh"
     write_bvh(plan.to_motion(), path)
     motion = read_bvh(path)
-    markers = transformer._marker_set(motion.skeleton)
+    markers = transformer.marker_set(motion.skeleton)
     world = markers.positions(motion.skeleton, motion.channels) * transformer.skeleton.meters_per_unit  # BVH: no units
     planned = plan.marker_positions()
     error = np.linalg.norm(world @ plan_axes(motion.skeleton.up_axis) - planned, axis=-1)
