@@ -19,7 +19,8 @@ reference and small problems.
 import numpy as np
 from scipy.special import logsumexp
 
-from skmotion.tree._viterbi import best_scores, kbest_viterbi, max_marginals
+from skmotion.tree._beam import descend_layer, kbest_layer
+from skmotion.tree._viterbi import kbest_viterbi
 
 __all__ = ["NODE_PRIORS", "beam_decode", "exhaustive_viterbi", "node_log_posterior"]
 
@@ -135,119 +136,30 @@ def exhaustive_viterbi(tree, graphs, layer, frames, graph=0, *, n_paths=1, node_
     return paths[0], scores[0]
 
 
-def _trim_candidates(cand, none):
-    """Drop candidate slots that hold no node at any step of any problem.
+def _kernel_allowed(graphs, layer, node_prior):
+    """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``, or ``(0, 0)`` for every node."""
+    if node_prior == "layer":
+        return np.zeros((0, 0), dtype=np.uint8)
+    return np.ascontiguousarray(_allowed_nodes(graphs, layer, node_prior), dtype=np.uint8)
 
-    The children of distinct nodes are distinct, so the candidates of a frame
-    never repeat; only "no node" entries (``none``) can, and slots of nothing
-    but those are dropped.
+
+def _children(tree, layer):
+    return np.ascontiguousarray(tree.children(layer))
+
+
+def _descend(tree, graphs, frames, frame_start, n_steps, graph, *, layer, n_paths, node_prior):
+    """Each frame's ``n_paths`` best nodes at ``layer``, ``(sum(n_steps), width)``; -1 for none.
+
+    Problem ``p``'s rows start at ``cumsum(n_steps)[p - 1]``.
     """
-    used = (cand != none).any(axis=(0, 2))
-    used[0] = True
-    return cand if used.all() else np.ascontiguousarray(cand[:, used])
-
-
-def _emissions(tree, layer, frames, pos, cand, graph_of_problem, allowed, normalise):
-    """Log emission score of each candidate, ``(n_steps, n_candidates, n_problems)``.
-
-    ``cand`` holds node indices, ``K`` for "no candidate" (-inf). With
-    ``normalise`` the scores are ``log Ps(k | x)``; without, ``log Po(x | k)``:
-    the normaliser is the same for every node of a frame (within a graph), so
-    it changes no ranking of sequences.
-    """
-    k = len(tree.node_ids(layer))
-    if normalise:
-        log_po = np.empty((len(frames), k + 1))
-        log_po[:, :k] = tree.log_likelihood(frames, layer)
-        log_po[:, k] = -np.inf
-        emit = log_po.ravel().take(pos[:, None, :] * (k + 1) + cand)
-        norm = _log_normaliser(log_po[:, :k], allowed)
-        graph_col = graph_of_problem if allowed.shape[0] > 1 else np.zeros_like(graph_of_problem)
-        emit -= norm[pos, graph_col[None, :]][:, None, :]
-        return emit
-    # only the candidates' densities: far fewer than every node on every frame
-    rows = np.broadcast_to(pos[:, None, :], cand.shape)
-    real = cand < k
-    emit = np.full(cand.shape, -np.inf)
-    emit[real] = tree.log_likelihood_pairs(frames[rows[real]], layer, cand[real])
-    return emit
-
-
-def _trellis(graphs, layer, cand, emit, graph_of_problem, pad, moves=None):
-    """The candidates' trellis ``(initial, steps)`` for :mod:`_viterbi`.
-
-    ``moves``, when given, holds the transitions' log probabilities already.
-    """
-    if moves is None:
-        moves = graphs.log_prob(layer, graph_of_problem, cand[:-1, :, None, :], cand[1:, None, :, :])
-    steps = moves
-    steps += emit[1:, None, :, :]
-    # A padded step repeats the last frame: identity moves of score 0.
-    t, b = np.nonzero(pad[1:])
-    steps[t, :, :, b] = np.where(np.eye(cand.shape[1], dtype=bool), 0.0, -np.inf)
-    return emit[0], steps
-
-
-def _shared_moves(graphs, layer, cand, clip_of_problem, graph_of_problem):
-    """Transition log probabilities of problems that share their clip's candidates.
-
-    ``cand`` is ``(n_steps, n_candidates, n_clips)``; each candidate pair is read
-    once for all graphs, and problem ``b`` takes clip ``clip_of_problem[b]`` under
-    graph ``graph_of_problem[b]``. Returns ``(n_steps - 1, n_candidates, n_candidates, n_problems)``.
-    """
-    moves = graphs.log_prob_all(layer, cand[:-1, :, None, :], cand[1:, None, :, :])
-    moves = moves.reshape(moves.shape[:3] + (cand.shape[2] * graphs.n_graphs,))
-    column = clip_of_problem * graphs.n_graphs + graph_of_problem
-    if len(column) == moves.shape[3] and (column == np.arange(len(column))).all():
-        return moves  # every graph of every clip, clip after clip: already in order
-    return np.take(moves, column, axis=3)
-
-
-def _candidates(tree, graphs, depth, beam, graph_of_problem, node_prior):
-    """Children (in layer ``depth``) of the kept nodes, ``(n_steps, n_candidates, n_problems)``.
-
-    Node index ``K`` of a layer stands for "no node"; its children are none too.
-    """
-    k = graphs.n_nodes(depth)
-    kids = tree.children(depth - 1)
-    children = np.full((len(kids) + 1, 2), k, dtype=np.intp)
-    children[:-1] = np.where(kids >= 0, kids, k)
-    cand = np.concatenate([children[:, 0][beam], children[:, 1][beam]], axis=1)
-    allowed = _allowed_nodes(graphs, depth, node_prior)
-    if allowed.shape[0] > 1:
-        ok = np.append(allowed, np.zeros((len(allowed), 1), dtype=bool), axis=1)
-        cand = np.where(ok.ravel().take(graph_of_problem * (k + 1) + cand), cand, k)
-    return _trim_candidates(cand, k), allowed
-
-
-def _layout(offsets, clip_of_problem):
-    """Frame bookkeeping of a batch, time first and problems last.
-
-    Short clips are padded by repeating their last frame (``pad`` marks those
-    steps). Returns the positions of each step's frame in ``used`` (the sorted
-    frame indices the batch needs), ``used`` and ``pad``.
-    """
-    lengths = np.diff(offsets)[clip_of_problem]
-    steps = np.arange(int(lengths.max()))[:, None]
-    frame_idx = offsets[clip_of_problem][None, :] + np.minimum(steps, lengths[None, :] - 1)
-    used, pos = np.unique(frame_idx, return_inverse=True)
-    return pos.reshape(frame_idx.shape), used, steps >= lengths[None, :]
-
-
-def _descend(tree, graphs, frames, pos, pad, graph_of_problem, *, layer, n_paths, node_prior):
-    """The per-frame beam at ``layer``: each frame's ``n_paths`` best nodes, ``(n_steps, width, n_problems)``."""
-    beam = np.zeros((pos.shape[0], 1, pos.shape[1]), dtype=np.intp)
+    rows = np.concatenate([[0], np.cumsum(n_steps)[:-1]]).astype(np.intp)
+    beam = np.zeros((int(np.sum(n_steps)), 1), dtype=np.intp)  # layer 0: the root
+    gauss = tree.kernel_gaussians()
     for depth in range(1, layer + 1):
-        cand, allowed = _candidates(tree, graphs, depth, beam, graph_of_problem, node_prior)
-        if cand.shape[1] <= n_paths:
-            beam = cand  # the beam keeps every candidate: nothing to score
-            continue
-        emit = _emissions(tree, depth, frames, pos, cand, graph_of_problem, allowed, normalise=False)
-        marginals = max_marginals(*_trellis(graphs, depth, cand, emit, graph_of_problem, pad))
-        keep = np.argsort(-marginals, axis=1, kind="stable")[:, :n_paths]
-        beam = np.take_along_axis(cand, keep, axis=1)
-        beam[np.take_along_axis(marginals, keep, axis=1) == -np.inf] = graphs.n_nodes(depth)
-    return beam
+        beam = descend_layer(frames, frame_start, n_steps, beam, rows, graph, _children(tree, depth - 1),
+                             _kernel_allowed(graphs, depth, node_prior), gauss, tree.node_ids(depth),
+                             graphs.kernel_table(depth), n_paths)
+    return beam, rows
 
 
 def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, *, layer, n_paths=5,
@@ -320,59 +232,47 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     offsets = np.asarray(offsets, dtype=np.intp)
     clip_of_problem = np.asarray(clip_of_problem, dtype=np.intp)
     graph_of_problem = np.asarray(graph_of_problem, dtype=np.intp)
-    frames = np.asarray(frames, dtype=np.float64)
-    pos, used, pad = _layout(offsets, clip_of_problem)
-    n_problems, n_steps = len(clip_of_problem), pos.shape[0]
+    frames = np.ascontiguousarray(frames, dtype=np.float64)
+    n_problems = len(clip_of_problem)
+    lengths = np.diff(offsets)
+    n_steps = int(lengths[clip_of_problem].max()) if n_problems else 0
     if layer == 0:
         paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
         paths[:, 0] = 0
         scores = np.full((n_problems, n_paths), -np.inf)
         scores[:, 0] = 0.0
         return paths, scores
-    moves = None
-    if guide is None:
-        beam = _descend(tree, graphs, frames[used], pos, pad, graph_of_problem, layer=layer - 1,
-                        n_paths=n_paths, node_prior=node_prior)
-        cand, allowed = _candidates(tree, graphs, layer, beam, graph_of_problem, node_prior)
-        emit = _emissions(tree, layer, frames[used], pos, cand, graph_of_problem, allowed, normalise)
-    else:
+    if guide is None:  # every problem searches the upper layers under its own graph
+        beam, beam_start = _descend(tree, graphs, frames, offsets[clip_of_problem], lengths[clip_of_problem],
+                                    graph_of_problem, layer=layer - 1, n_paths=n_paths, node_prior=node_prior)
+    else:  # one search per clip under the guide, shared by the clip's problems
         clips, inverse = np.unique(clip_of_problem, return_inverse=True)
-        clip_pos, clip_used, clip_pad = _layout(offsets, clips)
-        first = np.zeros(len(clips), dtype=np.intp)
-        beam = _descend(tree, guide, frames[clip_used], clip_pos, clip_pad, first, layer=layer - 1,
-                        n_paths=n_paths, node_prior=node_prior)
-        if node_prior == "layer":  # the same candidates and emissions for every graph of a clip
-            cand, allowed = _candidates(tree, graphs, layer, beam, first, node_prior)
-            emit = _emissions(tree, layer, frames[clip_used], clip_pos, cand, first, allowed, normalise)
-            moves = _shared_moves(graphs, layer, cand, inverse, graph_of_problem)
-            cand, emit = cand[:, :, inverse], emit[:, :, inverse]
-        else:
-            cand, allowed = _candidates(tree, graphs, layer, beam[:, :, inverse], graph_of_problem, node_prior)
-            emit = _emissions(tree, layer, frames[used], pos, cand, graph_of_problem, allowed, normalise)
-    initial, steps = _trellis(graphs, layer, cand, emit, graph_of_problem, pad, moves)
-    if prune and n_paths > 1:
-        return _pruned_kbest(initial, steps, cand, clip_of_problem, n_paths)
-    return _paths(cand, *kbest_viterbi(initial, steps, n_paths))
-
-
-def _pruned_kbest(initial, steps, cand, clip_of_problem, n_paths):
-    """:func:`kbest_viterbi` on the problems that may win their clip; -inf for the others."""
-    best = best_scores(initial, steps)
+        beam, clip_rows = _descend(tree, guide, frames, offsets[clips], lengths[clips],
+                                   np.zeros(len(clips), dtype=np.intp), layer=layer - 1, n_paths=n_paths,
+                                   node_prior=node_prior)
+        beam_start = clip_rows[inverse]
+    allowed = _allowed_nodes(graphs, layer, node_prior)
+    norm, norm_col = np.zeros((0, 0)), np.zeros(n_problems, dtype=np.intp)
+    if normalise:
+        norm = np.ascontiguousarray(_log_normaliser(tree.log_likelihood(frames, layer), allowed))
+        if allowed.shape[0] > 1:
+            norm_col = graph_of_problem
+    args = (frames, offsets[clip_of_problem], lengths[clip_of_problem], beam, beam_start, graph_of_problem,
+            _children(tree, layer - 1), _kernel_allowed(graphs, layer, node_prior), tree.kernel_gaussians(),
+            tree.node_ids(layer), graphs.kernel_table(layer), norm, norm_col, n_paths)
+    if not (prune and n_paths > 1):
+        return kbest_layer(*args, False)
+    # The sum of n_paths sequences lies between the best one and n_paths times it.
+    _, best = kbest_layer(*args, True)
+    best = best[:, 0]
     clips, inverse = np.unique(clip_of_problem, return_inverse=True)
     top = np.full(len(clips), -np.inf)
     np.maximum.at(top, inverse, best)
     # Kept with a margin for rounding in the sums of n_paths terms.
     live = np.flatnonzero(best + np.log(n_paths) >= top[inverse] - 1e-9 * np.abs(top[inverse]))
-    paths = np.full((len(best), n_paths, len(cand)), -1, dtype=np.intp)
-    scores = np.full((len(best), n_paths), -np.inf)
-    slots, live_scores = kbest_viterbi(initial[:, live], steps[..., live], n_paths)
-    paths[live], scores[live] = _paths(cand[..., live], slots, live_scores)
-    return paths, scores
-
-
-def _paths(cand, slots, scores):
-    """Node sequences from the K-best pass's candidate slots."""
-    nodes = cand.transpose(2, 0, 1)  # (problem, step, candidate)
-    paths = np.take_along_axis(nodes[:, None], np.maximum(slots, 0)[..., None], axis=3)[..., 0]
-    paths[slots < 0] = -1
+    paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
+    scores = np.full((n_problems, n_paths), -np.inf)
+    live_args = [a[live] if i in (1, 2, 4, 5, 12) else a for i, a in enumerate(args)]
+    live_paths, scores[live] = kbest_layer(*live_args, False)
+    paths[live, :, : live_paths.shape[2]] = live_paths
     return paths, scores

@@ -177,9 +177,41 @@ class Gaussians:
             self._precisions = 1.0 / self.covariances
             log_det = d * np.log(self.covariances)
         self._const = -0.5 * (log_det + d * _LOG_2PI)
+        self._kernel = self._kernel_arrays()
 
     def __len__(self):
         return len(self.means)
+
+    def kernel_arrays(self):
+        """The arrays the compiled decoder reads (:mod:`skmotion.tree._beam`), by tree node id.
+
+        Made once, with the Gaussians.
+
+        Returns
+        -------
+        arrays : dict
+            ``means`` ``(n, d)``; ``prec``: flat per-channel precisions (``"diag"``
+            and ``"spherical"``, the latter repeated over channels) or flat upper
+            triangular factors ``U`` with ``U U^T`` the precision (``"full"``);
+            ``shifts`` ``(n, d)``, ``mean @ U`` (a ``(1, 1)`` placeholder otherwise);
+            ``const`` ``(n,)``; ``full``.
+        """
+        return self._kernel
+
+    def _kernel_arrays(self):
+        n, d = self.means.shape
+        if self.kind == "full":
+            prec, shifts = self._prec_chol, self._shifts
+        else:
+            prec = np.broadcast_to(self._precisions.reshape(n, -1), (n, d))
+            shifts = np.zeros((1, 1))
+        return {
+            "means": np.ascontiguousarray(self.means),
+            "prec": np.ascontiguousarray(prec, dtype=np.float64).ravel(),
+            "shifts": np.ascontiguousarray(shifts, dtype=np.float64),
+            "const": np.ascontiguousarray(self._const, dtype=np.float64),
+            "full": self.kind == "full",
+        }
 
     def log_pdf(self, X, nodes=None):
         """Log density of every frame under every (or the chosen) Gaussian.
@@ -202,40 +234,6 @@ class Gaussians:
         out = np.empty((len(X), len(nodes)))
         for start in range(0, len(X), step):
             out[start : start + step] = self._log_pdf_block(X[start : start + step], nodes)
-        return out
-
-    def log_pdf_pairs(self, X, nodes):
-        """Log density of frame ``i`` under Gaussian ``nodes[i]``, for every ``i``.
-
-        Cheaper than :meth:`log_pdf` when only a few Gaussians matter per frame.
-
-        Parameters
-        ----------
-        X : ndarray of shape (n_pairs, n_channels)
-        nodes : ndarray of shape (n_pairs,)
-
-        Returns
-        -------
-        log_pdf : ndarray of shape (n_pairs,)
-        """
-        X = np.asarray(X, dtype=np.float64)
-        nodes = np.asarray(nodes, dtype=np.intp)
-        out = np.empty(len(X))
-        if self.kind == "full":
-            # One product per distinct Gaussian: a gathered (pairs, d, d) stack would be huge.
-            order = np.argsort(nodes, kind="stable")
-            distinct, starts = np.unique(nodes[order], return_index=True)
-            for node, rows in zip(distinct, np.split(order, starts[1:])):
-                y = X[rows] @ self._prec_chol[node] - self._shifts[node]
-                out[rows] = self._const[node] - 0.5 * np.einsum("pe,pe->p", y, y)
-            return out
-        step = max(1, _CHUNK_ELEMENTS // X.shape[1])
-        for start in range(0, len(X), step):
-            x, k = X[start : start + step], nodes[start : start + step]
-            diff = x - self.means[k]
-            prec = self._precisions[k] if self.kind == "diag" else self._precisions[k][:, None]
-            maha = np.einsum("pd,pd->p", diff * diff, np.broadcast_to(prec, diff.shape))
-            out[start : start + step] = self._const[k] - 0.5 * maha
         return out
 
     def _log_pdf_block(self, X, nodes):

@@ -304,22 +304,9 @@ class MotionTree:
             ids = ids[np.asarray(nodes, dtype=np.intp)]
         return self._gaussians.log_pdf(self._check_frames(frames), ids)
 
-    def log_likelihood_pairs(self, frames, layer, nodes):
-        """``log Po(frames[i] | nodes[i])`` for pairs of frames and nodes of a layer.
-
-        Parameters
-        ----------
-        frames : array-like of shape (n_pairs, n_channels)
-        layer : int
-        nodes : array-like of int of shape (n_pairs,)
-            Layer indices of the nodes.
-
-        Returns
-        -------
-        log_pdf : ndarray of shape (n_pairs,)
-        """
-        ids = self.node_ids(layer)[np.asarray(nodes, dtype=np.intp)]
-        return self._gaussians.log_pdf_pairs(self._check_frames(frames), ids)
+    def kernel_gaussians(self):
+        """The nodes' Gaussians as the compiled decoder reads them (see ``Gaussians.kernel_arrays``)."""
+        return self._gaussians.kernel_arrays()
 
     def _check_frames(self, frames):
         X = np.asarray(frames, dtype=np.float64)

@@ -75,6 +75,7 @@ class TransitionGraphs:
         self._totals = [np.asarray(c.sum(axis=1)).ravel().reshape(self.n_graphs, -1) for c in self._counts]
         self._dense = [self._dense_log(layer) for layer in range(self.n_layers)]
         self._keys = [None if d is not None else self._sorted_keys(layer) for layer, d in enumerate(self._dense)]
+        self._kernel = [self._kernel_table(layer) for layer in range(self.n_layers)]
 
     @classmethod
     def count(cls, layer_labels, n_nodes, *, offsets, graph_of_clip, n_graphs=None, smoothing=1.0):
@@ -122,7 +123,7 @@ class TransitionGraphs:
         """The log table ``(K + 1, K + 1, n_graphs)``, flat; index ``K`` is "no node" (-inf).
 
         Graphs last, so the probabilities of one transition in every graph are
-        contiguous (:meth:`log_prob_all`).
+        contiguous.
         """
         k = self.n_nodes(layer)
         if self.n_graphs * (k + 1) ** 2 > _DENSE_LIMIT:
@@ -144,6 +145,34 @@ class TransitionGraphs:
         rows = np.repeat(np.arange(csr.shape[0], dtype=np.int64), np.diff(csr.indptr))
         graph, src = np.divmod(rows, k)
         return (graph * (k + 1) + src) * (k + 1) + csr.indices
+
+    def kernel_table(self, layer):
+        """A layer's log probabilities as the compiled decoder reads them (:mod:`skmotion.tree._beam`).
+
+        Made once, when the graphs are.
+
+        Returns
+        -------
+        table : tuple
+            ``(indptr, indices, seen, unseen, K, dense, n_graphs)``: row ``g K + m``
+            of the count matrix lists the nodes ``indices[indptr[r]:indptr[r + 1]]``
+            (sorted) that ``m`` moved to in graph ``g``, ``seen`` their log
+            probabilities, and ``unseen[r]`` that of every other node; ``dense``
+            is the flat ``(K + 1, K + 1, n_graphs)`` table of all of them where
+            it is small enough to keep (a lookup without a search), else empty.
+        """
+        return self._kernel[layer]
+
+    def _kernel_table(self, layer):
+        csr = self._counts[layer]
+        k = self.n_nodes(layer)
+        rows = np.repeat(np.arange(csr.shape[0]), np.diff(csr.indptr))
+        denominator = self._totals[layer].ravel() + self.smoothing
+        # The same expression as log_prob's, so both give the same doubles.
+        seen = np.log((csr.data + self.pseudo_count(layer)) / denominator[rows])
+        unseen = np.log((0 + self.pseudo_count(layer)) / denominator)
+        dense = self._dense[layer] if self._dense[layer] is not None else np.zeros(0)
+        return (csr.indptr.astype(np.intp), csr.indices.astype(np.intp), seen, unseen, k, dense, self.n_graphs)
 
     def n_nodes(self, layer):
         """Number of nodes of a layer."""
@@ -203,36 +232,6 @@ class TransitionGraphs:
             out = np.log((t + self.pseudo_count(layer)) / (totals.take(row) + self.smoothing))
         out[np.broadcast_to((src == k) | (dst == k), out.shape)] = -np.inf
         return out
-
-    def log_prob_all(self, layer, src, dst):
-        """``log p(src -> dst)`` in every graph: :meth:`log_prob` with the graphs on a new last axis.
-
-        Faster than broadcasting ``graph`` in :meth:`log_prob`, as the values of
-        one transition in all graphs are read together.
-
-        Parameters
-        ----------
-        layer : int
-        src, dst : array-like of int
-            Node indices (broadcast together); negative or ``K``: "no node".
-
-        Returns
-        -------
-        log_p : ndarray of shape ``broadcast(src, dst).shape + (n_graphs,)``
-
-        Examples
-        --------
-        >>> from skmotion.tree import TransitionGraphs
-        >>> g = TransitionGraphs.count([[0, 0, 1, 1]], [2], offsets=[0, 2, 4], graph_of_clip=[0, 1])
-        >>> g.log_prob_all(0, [0, 1], [0, 1]).shape
-        (2, 2)
-        """
-        k = self.n_nodes(layer)
-        src, dst = np.broadcast_arrays(*(np.asarray(a, dtype=np.intp) for a in (src, dst)))
-        if self._dense[layer] is None:
-            return self.log_prob(layer, np.arange(self.n_graphs), src[..., None], dst[..., None])
-        src, dst = (np.where(a < 0, k, a) if a.size and a.min() < 0 else a for a in (src, dst))
-        return self._dense[layer].reshape(-1, self.n_graphs).take(src * (k + 1) + dst, axis=0)
 
     def matrix(self, layer, graph):
         """The dense ``(K, K)`` transition probabilities of one graph (small layers)."""

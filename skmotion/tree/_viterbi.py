@@ -14,7 +14,7 @@ after step, as it must.
 
 import numpy as np
 
-__all__ = ["best_scores", "kbest_viterbi", "max_marginals"]
+__all__ = ["kbest_viterbi", "max_marginals"]
 
 
 def max_marginals(initial, steps):
@@ -52,36 +52,6 @@ def max_marginals(initial, steps):
         np.max(steps[t] + backward[t + 1][None, :, :], axis=1, out=backward[t])
     forward += backward
     return forward
-
-
-def best_scores(initial, steps):
-    """The score of the best sequence of each trellis (the forward max-product pass alone).
-
-    Equal to the first score of :func:`kbest_viterbi`, as it adds and compares
-    the same terms, at a fraction of its cost.
-
-    Parameters
-    ----------
-    initial : ndarray of shape (n_states, n_problems)
-    steps : ndarray of shape (n_steps - 1, n_states, n_states, n_problems)
-
-    Returns
-    -------
-    scores : ndarray of shape (n_problems,)
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from skmotion.tree._viterbi import best_scores
-    >>> initial = np.log([[0.9], [0.1]])
-    >>> steps = np.log(0.5 * np.array([[[[0.2], [0.8]], [[0.2], [0.8]]]]))
-    >>> np.round(np.exp(best_scores(initial, steps)), 3).tolist()
-    [0.36]
-    """
-    forward = initial
-    for step in steps:
-        forward = np.max(forward[:, None, :] + step, axis=0)
-    return forward.max(axis=0)
 
 
 def _top_ranks(scores, n_paths, n_lists):

@@ -70,14 +70,3 @@ def test_log_pdf_matches_scipy(kind):
 def test_unknown_kind():
     with pytest.raises(ValueError, match="covariance_type must be one of"):
         estimate_covariance(np.zeros((2, 2)), np.zeros(2), "tied", 0.0)
-
-
-@pytest.mark.parametrize("kind", ["full", "diag", "spherical"])
-def test_pairs_match_the_full_table(kind):
-    rng = np.random.default_rng(2)
-    means = rng.normal(size=(5, 3))
-    covs = {"full": np.stack([np.eye(3) * (1 + i) + 0.3 for i in range(5)]), "diag": rng.uniform(0.5, 2, (5, 3)),
-            "spherical": rng.uniform(0.5, 2, 5)}[kind]
-    g = Gaussians(means, covs, kind)
-    X, nodes = rng.normal(size=(40, 3)), rng.integers(0, 5, 40)
-    np.testing.assert_allclose(g.log_pdf_pairs(X, nodes), g.log_pdf(X)[np.arange(40), nodes], rtol=1e-10)

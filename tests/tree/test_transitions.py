@@ -1,5 +1,7 @@
 """Transition graphs: counts against a plain loop, exact smoothing, rows summing to 1."""
 
+import itertools
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -94,13 +96,18 @@ def test_smoothing_must_be_positive():
         TransitionGraphs.count([np.zeros(3, int)], [1], offsets=[0, 3], graph_of_clip=[0], smoothing=0)
 
 
-def test_log_prob_all_reads_every_graph_at_once(monkeypatch, rng):
+def test_the_kernel_table_holds_every_log_probability(monkeypatch, rng):
+    """The compiled decoder's lookups (dense table, or sorted rows and unseen mass) give log_prob exactly."""
     dense, sparse = dense_and_sparse(monkeypatch, rng.integers(0, 6, size=150), 6, offsets=[0, 40, 90, 150],
                                      graph_of_clip=[0, 1, 2], smoothing=0.7)
-    src, dst = rng.integers(-1, 7, (4, 5)), rng.integers(-1, 7, (4, 5))
-    expected = np.stack([dense.log_prob(0, g, src, dst) for g in range(3)], axis=-1)
-    for graphs in (dense, sparse):
-        np.testing.assert_array_equal(graphs.log_prob_all(0, src, dst), expected)
-    # against the probabilities themselves
-    P = dense.matrix(0, 1)
-    np.testing.assert_allclose(np.exp(dense.log_prob_all(0, [2], [4])[0, 1]), P[2, 4])
+    for graphs, has_dense in ((dense, True), (sparse, False)):
+        indptr, indices, seen, unseen, k, table, n_graphs = graphs.kernel_table(0)
+        assert (k, n_graphs, len(table) > 0) == (6, 3, has_dense)
+        for g, src, dst in itertools.product(range(3), range(6), range(6)):
+            expected = dense.log_prob(0, g, src, dst)
+            row = g * k + src
+            stored = indices[indptr[row] : indptr[row + 1]]
+            looked_up = seen[indptr[row] + np.flatnonzero(stored == dst)[0]] if dst in stored else unseen[row]
+            assert looked_up == expected
+            if has_dense:
+                assert table[(src * (k + 1) + dst) * n_graphs + g] == expected

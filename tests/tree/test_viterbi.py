@@ -66,14 +66,3 @@ def test_ten_thousand_steps_do_not_underflow():
     np.testing.assert_allclose(scores[0, 0], np.log(0.5) + (n_steps - 1) * np.log(0.72))
     assert (paths[0, 0] == 0).all()
     assert np.isfinite(max_marginals(initial, steps)).all()
-
-
-@given(trellises())
-def test_best_scores_is_the_first_kbest_score(trellis):
-    from skmotion.tree._viterbi import best_scores
-
-    initial, steps = trellis
-    _, scores = kbest_viterbi(initial, steps, 1)
-    np.testing.assert_array_equal(best_scores(initial, steps), scores[:, 0])
-    for b in range(initial.shape[1]):
-        np.testing.assert_allclose(best_scores(initial, steps)[b], all_sequences(initial, steps, b)[0][0])
