@@ -138,16 +138,25 @@ cdef void _steps(const Problem* pb, const Table* tab, const intp* cand, const do
     A node stays for many frames, so the candidates of consecutive frames often
     repeat; the moves ``(n_cand, n_cand)`` are looked up again only when they change.
     """
-    cdef intp t, i, j, src
+    cdef intp t, i, j, src, dst
     cdef double* row
     cdef const double* move
+    cdef const double* base
     for t in range(pb.n_steps - 1):
         if t == 0 or not (_same_row(cand + t * n_cand, cand + (t - 1) * n_cand, n_cand)
                           and _same_row(cand + (t + 1) * n_cand, cand + t * n_cand, n_cand)):
-            for i in range(n_cand):
-                src = cand[t * n_cand + i]
-                for j in range(n_cand):
-                    moves[i * n_cand + j] = _transition(tab, pb.graph, src, cand[(t + 1) * n_cand + j])
+            if tab.dense != NULL:  # no search and no branch: "no node" is row and column K, -inf
+                for i in range(n_cand):
+                    src = cand[t * n_cand + i]
+                    base = tab.dense + (tab.k if src < 0 else src) * (tab.k + 1) * tab.n_graphs + pb.graph
+                    for j in range(n_cand):
+                        dst = cand[(t + 1) * n_cand + j]
+                        moves[i * n_cand + j] = base[(tab.k if dst < 0 else dst) * tab.n_graphs]
+            else:
+                for i in range(n_cand):
+                    src = cand[t * n_cand + i]
+                    for j in range(n_cand):
+                        moves[i * n_cand + j] = _transition(tab, pb.graph, src, cand[(t + 1) * n_cand + j])
         for i in range(n_cand):
             row = steps + (t * n_cand + i) * n_cand
             move = moves + i * n_cand

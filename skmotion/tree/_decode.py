@@ -206,7 +206,9 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         sequences lies between the best one and ``n_paths`` times it, so a
         problem whose best sequence scores more than ``log(n_paths)`` below
         the best sequence of another problem of the same clip can never win;
-        it gets ``-inf`` scores and -1 paths. Which problem wins is unchanged.
+        it gets ``-inf`` scores and -1 paths. A clip left with one problem
+        has its winner: that problem gets only its best sequence's score (the
+        others ``-inf``) and -1 paths. Which problem wins is unchanged.
 
     Returns
     -------
@@ -269,9 +271,12 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     top = np.full(len(clips), -np.inf)
     np.maximum.at(top, inverse, best)
     # Kept with a margin for rounding in the sums of n_paths terms.
-    live = np.flatnonzero(best + np.log(n_paths) >= top[inverse] - 1e-9 * np.abs(top[inverse]))
+    live = best + np.log(n_paths) >= top[inverse] - 1e-9 * np.abs(top[inverse])
     paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
     scores = np.full((n_problems, n_paths), -np.inf)
+    alone = live & (np.bincount(inverse, weights=live)[inverse] == 1)
+    scores[alone, 0] = best[alone]
+    live = np.flatnonzero(live & ~alone)
     live_args = [a[live] if i in (1, 2, 4, 5, 12) else a for i, a in enumerate(args)]
     live_paths, scores[live] = kbest_layer(*live_args, False)
     paths[live, :, : live_paths.shape[2]] = live_paths
