@@ -47,6 +47,7 @@ def test_readme_gives_the_two_setup_commands():
 
 def test_architecture_lists_every_module():
     text = (ROOT / "docs" / "architecture.md").read_text()
-    modules = [p.relative_to(ROOT).as_posix() for p in (ROOT / "skmotion").rglob("*.py") if p.name != "__init__.py"]
+    modules = [p.relative_to(ROOT).as_posix() for pattern in ("*.py", "*.pyx")
+               for p in (ROOT / "skmotion").rglob(pattern) if p.name != "__init__.py"]
     missing = [m for m in modules if Path(m).name not in text]
     assert not missing, f"docs/architecture.md does not mention {missing}"

@@ -54,26 +54,45 @@ cdef struct Problem:
     intp norm_stride
 
 
-cdef inline double _emission(const Gaussians* g, const double* x, intp node) noexcept nogil:
-    """Log density of frame ``x`` under the node's Gaussian."""
+cdef inline double _emission(const Gaussians* g, const double* x, intp node, double* y) noexcept nogil:
+    """Log density of frame ``x`` under the node's Gaussian; ``y`` is scratch of ``d`` doubles.
+
+    Sums run in four independent parts: one running sum is a chain of
+    dependent additions that the compiler may not reorder, four keep the
+    processor's pipelines full.
+    """
     cdef intp n = g.ids[node], d = g.d, a, b
     cdef const double* p
-    cdef double maha = 0.0, y, diff
+    cdef const double* mu
+    cdef double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0, xa
     if g.full:
-        # y = x @ U - mean @ U with U upper triangular: only its upper part is read
+        # y = x @ U - mean @ U, U upper triangular, row by row (contiguous and independent per column)
         p = g.prec + n * d * d
+        mu = g.shifts + n * d
         for b in range(d):
-            y = 0.0
-            for a in range(b + 1):
-                y += x[a] * p[a * d + b]
-            y -= g.shifts[n * d + b]
-            maha += y * y
+            y[b] = -mu[b]
+        for a in range(d):
+            xa = x[a]
+            for b in range(a, d):
+                y[b] += xa * p[a * d + b]
+        for b in range(d):
+            y[b] = y[b] * y[b]
     else:
         p = g.prec + n * d
+        mu = g.means + n * d
         for a in range(d):
-            diff = x[a] - g.means[n * d + a]
-            maha += diff * diff * p[a]
-    return g.const_[n] - 0.5 * maha
+            y[a] = (x[a] - mu[a]) * (x[a] - mu[a]) * p[a]
+    a = 0
+    while a + 4 <= d:
+        s0 += y[a]
+        s1 += y[a + 1]
+        s2 += y[a + 2]
+        s3 += y[a + 3]
+        a += 4
+    while a < d:
+        s0 += y[a]
+        a += 1
+    return g.const_[n] - 0.5 * ((s0 + s1) + (s2 + s3))
 
 
 cdef inline double _transition(const Table* t, intp graph, intp src, intp dst) noexcept nogil:
@@ -108,7 +127,8 @@ cdef void _candidates(const Problem* pb, const intp* children, intp* cand) noexc
                 cand[t * n_cand + side * width + w] = child
 
 
-cdef void _emissions(const Problem* pb, const Gaussians* g, const intp* cand, intp n_cand, double* emit) noexcept nogil:
+cdef void _emissions(const Problem* pb, const Gaussians* g, const intp* cand, intp n_cand, double* emit,
+                     double* y) noexcept nogil:
     cdef intp t, c, node
     cdef const double* x
     for t in range(pb.n_steps):
@@ -118,7 +138,7 @@ cdef void _emissions(const Problem* pb, const Gaussians* g, const intp* cand, in
             if node < 0:
                 emit[t * n_cand + c] = -INFINITY
             else:
-                emit[t * n_cand + c] = _emission(g, x, node)
+                emit[t * n_cand + c] = _emission(g, x, node, y)
                 if pb.norm != NULL:
                     emit[t * n_cand + c] -= pb.norm[t * pb.norm_stride]
 
@@ -336,8 +356,9 @@ def descend_layer(const double[:, ::1] frames, const intp[::1] frame_start, cons
     cdef double* fwd = <double*> malloc(max(max_steps * n_cand, 1) * sizeof(double))
     cdef double* bwd = <double*> malloc(max(max_steps * n_cand, 1) * sizeof(double))
     cdef double* moves = <double*> malloc(n_cand * n_cand * sizeof(double))
-    if cand == NULL or emit == NULL or steps == NULL or fwd == NULL or bwd == NULL or moves == NULL:
-        free(cand); free(emit); free(steps); free(fwd); free(bwd); free(moves)
+    cdef double* y = <double*> malloc(g.d * sizeof(double))
+    if cand == NULL or emit == NULL or steps == NULL or fwd == NULL or bwd == NULL or moves == NULL or y == NULL:
+        free(cand); free(emit); free(steps); free(fwd); free(bwd); free(moves); free(y)
         raise MemoryError(f"decoding {max_steps} frames with {n_cand} candidates each")
     try:
         with nogil:
@@ -357,7 +378,7 @@ def descend_layer(const double[:, ::1] frames, const intp[::1] frame_start, cons
                         for c in range(n_cand):
                             out[beam_start[p] + t, c] = cand[t * n_cand + c]
                     continue
-                _emissions(&pb, &g, cand, n_cand, emit)
+                _emissions(&pb, &g, cand, n_cand, emit, y)
                 _steps(&pb, &tab, cand, emit, n_cand, moves, steps)
                 _max_marginals(pb.n_steps, n_cand, emit, steps, fwd, bwd)
                 for t in range(pb.n_steps):
@@ -367,7 +388,7 @@ def descend_layer(const double[:, ::1] frames, const intp[::1] frame_start, cons
                         c = _pick(fwd + t * n_cand, n_cand, &v)
                         out[beam_start[p] + t, r] = cand[t * n_cand + c] if v > -INFINITY else -1
     finally:
-        free(cand); free(emit); free(steps); free(fwd); free(bwd); free(moves)
+        free(cand); free(emit); free(steps); free(fwd); free(bwd); free(moves); free(y)
     return out_array
 
 
@@ -411,9 +432,10 @@ def kbest_layer(const double[:, ::1] frames, const intp[::1] frame_start, const 
     cdef double* scratch = <double*> malloc(max(n_paths * n_cand, 1) * sizeof(double))
     cdef intp* back = <intp*> malloc(size * n_paths * sizeof(intp))
     cdef double* moves = <double*> malloc(n_cand * n_cand * sizeof(double))
+    cdef double* y = <double*> malloc(g.d * sizeof(double))
     if (cand == NULL or emit == NULL or steps == NULL or delta == NULL or scratch == NULL or back == NULL
-            or moves == NULL):
-        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(moves)
+            or moves == NULL or y == NULL):
+        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(moves); free(y)
         raise MemoryError(f"decoding {max_steps} frames with {n_cand} candidates each")
     try:
         with nogil:
@@ -434,7 +456,7 @@ def kbest_layer(const double[:, ::1] frames, const intp[::1] frame_start, const 
                         and (pb.norm == NULL or norm_col[p] == norm_col[p - 1]))
                 if not same:
                     _candidates(&pb, &children[0, 0], cand)
-                    _emissions(&pb, &g, cand, n_cand, emit)
+                    _emissions(&pb, &g, cand, n_cand, emit, y)
                 _steps(&pb, &tab, cand, emit, n_cand, moves, steps)
                 if best_only:
                     scores[p, 0] = _best(pb.n_steps, n_cand, emit, steps, delta)
@@ -442,5 +464,5 @@ def kbest_layer(const double[:, ::1] frames, const intp[::1] frame_start, const 
                     _kbest(pb.n_steps, n_cand, n_paths, cand, emit, steps, delta, scratch, back,
                            &paths[p, 0, 0], max_steps, &scores[p, 0])
     finally:
-        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(moves)
+        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(moves); free(y)
     return paths_array, scores_array
