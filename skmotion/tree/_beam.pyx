@@ -251,11 +251,14 @@ cdef double _best(intp n_steps, intp n_cand, const double* emit, const double* s
 
 
 cdef void _kbest(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const double* emit,
-                 const double* steps, double* delta, double* scratch, intp* back, intp* paths,
+                 const double* steps, double* delta, double* scratch, intp* head, intp* back, intp* paths,
                  intp path_stride, double* scores) noexcept nogil:
-    """List Viterbi: the ``n_paths`` best slot sequences, as node paths (rows of -1 stay for missing ones)."""
-    cdef intp t, r, i, j, e, rank, state, n_entries = n_paths * n_cand
-    cdef double v
+    """List Viterbi: the ``n_paths`` best slot sequences, as node paths (rows of -1 stay for missing ones).
+
+    ``head`` is scratch of ``n_cand``: the rank of each slot's next unpicked entry.
+    """
+    cdef intp t, r, r2, i, j, e, arg, rank, state, n_entries = n_paths * n_cand
+    cdef double best
     cdef double* prev = delta
     cdef double* cur = delta + n_entries
     cdef double* tmp
@@ -264,13 +267,34 @@ cdef void _kbest(intp n_steps, intp n_cand, intp n_paths, const intp* cand, cons
         prev[e] = emit[e] if e < n_cand else -INFINITY
     for t in range(1, n_steps):
         for j in range(n_cand):
-            # entry r * n_cand + i: the rank-r sequence ending in slot i, moved on to j
+            # Entry r * n_cand + i: the rank-r sequence ending in slot i, moved on to j. Each
+            # slot's entries decrease with the rank, so the best remaining entry is always one
+            # of the slots' first unpicked ones (their heads): the picks merge n_cand sorted
+            # lists, ties to the lowest entry as an argmax over all entries would give.
+            for i in range(n_cand):
+                head[i] = 0
+                scratch[i] = prev[i] + steps[((t - 1) * n_cand + i) * n_cand + j]
             for r in range(n_paths):
+                arg = -1
+                best = -INFINITY
                 for i in range(n_cand):
-                    scratch[r * n_cand + i] = prev[r * n_cand + i] + steps[((t - 1) * n_cand + i) * n_cand + j]
-            for r in range(n_paths):
-                back[(t * n_paths + r) * n_cand + j] = _pick(scratch, n_entries, &v)
-                cur[r * n_cand + j] = v
+                    if head[i] < n_paths and scratch[i] > best:
+                        best = scratch[i]
+                        arg = i
+                if arg < 0:  # only -inf left: no sequence of this rank
+                    for r2 in range(r, n_paths):
+                        cur[r2 * n_cand + j] = -INFINITY
+                        back[(t * n_paths + r2) * n_cand + j] = 0
+                    break
+                # among equal heads the lowest entry: the lowest rank, then the lowest slot
+                for i in range(n_cand):
+                    if head[i] < n_paths and scratch[i] == best and head[i] * n_cand + i < head[arg] * n_cand + arg:
+                        arg = i
+                cur[r * n_cand + j] = best
+                back[(t * n_paths + r) * n_cand + j] = head[arg] * n_cand + arg
+                head[arg] += 1
+                if head[arg] < n_paths:
+                    scratch[arg] = prev[head[arg] * n_cand + arg] + steps[((t - 1) * n_cand + arg) * n_cand + j]
         tmp = prev
         prev = cur
         cur = tmp
@@ -431,11 +455,12 @@ def kbest_layer(const double[:, ::1] frames, const intp[::1] frame_start, const 
     cdef double* delta = <double*> malloc(2 * max(n_paths * n_cand, 1) * sizeof(double))
     cdef double* scratch = <double*> malloc(max(n_paths * n_cand, 1) * sizeof(double))
     cdef intp* back = <intp*> malloc(size * n_paths * sizeof(intp))
+    cdef intp* head = <intp*> malloc(max(n_cand, 1) * sizeof(intp))
     cdef double* moves = <double*> malloc(n_cand * n_cand * sizeof(double))
     cdef double* y = <double*> malloc(g.d * sizeof(double))
     if (cand == NULL or emit == NULL or steps == NULL or delta == NULL or scratch == NULL or back == NULL
-            or moves == NULL or y == NULL):
-        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(moves); free(y)
+            or head == NULL or moves == NULL or y == NULL):
+        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(head); free(moves); free(y)
         raise MemoryError(f"decoding {max_steps} frames with {n_cand} candidates each")
     try:
         with nogil:
@@ -461,8 +486,8 @@ def kbest_layer(const double[:, ::1] frames, const intp[::1] frame_start, const 
                 if best_only:
                     scores[p, 0] = _best(pb.n_steps, n_cand, emit, steps, delta)
                 else:
-                    _kbest(pb.n_steps, n_cand, n_paths, cand, emit, steps, delta, scratch, back,
+                    _kbest(pb.n_steps, n_cand, n_paths, cand, emit, steps, delta, scratch, head, back,
                            &paths[p, 0, 0], max_steps, &scores[p, 0])
     finally:
-        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(moves); free(y)
+        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(head); free(moves); free(y)
     return paths_array, scores_array
