@@ -8,13 +8,13 @@ from skmotion.utils._parallel import parallel_map
 __all__ = ["decode_clips", "length_groups"]
 
 # Clips are decoded in groups of at most this many (step, graph) pairs, counting
-# the padding of shorter clips to the longest of the group. Groups depend on the
-# data only, so results are the same for any n_jobs.
+# shorter clips at the length of the group's longest (the result arrays are
+# padded to it). Groups depend on the data only, so results are the same for any n_jobs.
 _GROUP_PAIRS = 1 << 17
 
 
 def length_groups(lengths, n_graphs, budget=_GROUP_PAIRS):
-    """Groups of clips of similar lengths, so little padding is decoded.
+    """Groups of clips of similar lengths, so the padded result arrays stay small.
 
     Clips are taken shortest first; a group grows while (its longest clip) x
     (its clips) x ``n_graphs`` stays within ``budget``.

@@ -214,7 +214,7 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     -------
     paths : ndarray of shape (n_problems, n_paths, max_frames)
         Node sequences (layer indices) at ``layer``, best first; a problem's
-        sequences are valid up to its clip's length; -1 rows for missing ones.
+        sequences end at its clip's length (-1 after it); -1 rows for missing ones.
     scores : ndarray of shape (n_problems, n_paths)
         Their log probabilities ``log P(N | X)`` (``-inf`` for missing sequences).
 

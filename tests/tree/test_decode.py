@@ -171,6 +171,7 @@ def test_clips_of_different_lengths_decode_as_if_alone(model, guided):
                                                 guide=guide)
         np.testing.assert_allclose(scores[i], alone_scores[0], atol=1e-12)
         np.testing.assert_array_equal(paths[i][:, : len(clip)], alone_paths[0])
+        assert (paths[i][:, len(clip) :] == -1).all()
 
 
 def test_layer_zero_is_the_root_with_probability_one(model):
