@@ -47,8 +47,8 @@ def length_groups(lengths, n_graphs, budget=_GROUP_PAIRS):
     return groups
 
 
-def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, node_prior, guide=None, normalise=True,
-                 prune=False, n_jobs=None):
+def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, node_prior, score_layers=1, guide=None,
+                 normalise=True, prune=False, return_paths=True, n_jobs=None):
     """Beam-decode every clip under every graph (see :func:`beam_decode`).
 
     Parameters
@@ -60,17 +60,17 @@ def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, nod
     offsets : ndarray of shape (n_clips + 1,)
     n_graphs : int
         Decode each clip under graphs ``0 .. n_graphs - 1``.
-    layer, n_paths, node_prior, guide, normalise, prune
+    layer, n_paths, node_prior, score_layers, guide, normalise, prune, return_paths
         As for :func:`beam_decode`.
     n_jobs : int, default=None
         Jobs over the groups of clips (joblib's meaning); results do not depend on it.
 
     Returns
     -------
-    paths : list of ndarray of shape (n_graphs, n_paths, n_frames_i)
-        Node sequences of each clip, best first.
-    scores : ndarray of shape (n_clips, n_graphs, n_paths)
-        Their log scores.
+    paths : list of ndarray of shape (n_graphs, n_paths, n_frames_i), or None
+        Node sequences of each clip at ``layer``, best first (None without ``return_paths``).
+    scores : ndarray of shape (n_clips, n_graphs, n_scored, n_paths)
+        Their log scores at each scored layer.
     """
     lengths = np.diff(offsets)
 
@@ -79,16 +79,20 @@ def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, nod
         graph_of_problem = np.tile(np.arange(n_graphs), len(group))
         paths, scores = beam_decode(
             tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, layer=layer, n_paths=n_paths,
-            node_prior=node_prior, guide=guide, normalise=normalise, prune=prune,
+            score_layers=score_layers, node_prior=node_prior, guide=guide, normalise=normalise, prune=prune,
+            return_paths=return_paths,
         )
-        return paths.reshape(len(group), n_graphs, *paths.shape[1:]), scores.reshape(len(group), n_graphs, -1)
+        if paths is not None:
+            paths = paths.reshape(len(group), n_graphs, *paths.shape[1:])
+        return paths, scores.reshape(len(group), n_graphs, *scores.shape[1:])
 
     groups = length_groups(lengths, n_graphs)
     results = parallel_map(work, groups, n_jobs=n_jobs)
-    paths = [None] * len(lengths)
-    scores = np.empty((len(lengths), n_graphs, n_paths))
+    scores = np.empty((len(lengths), n_graphs) + results[0][1].shape[2:])
+    paths = [None] * len(lengths) if return_paths else None
     for (group_paths, group_scores), group in zip(results, groups):
         scores[group] = group_scores
-        for i, clip in enumerate(group):
-            paths[clip] = group_paths[i, :, :, : lengths[clip]]
+        if return_paths:
+            for i, clip in enumerate(group):
+                paths[clip] = group_paths[i, :, :, : lengths[clip]]
     return paths, scores

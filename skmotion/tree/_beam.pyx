@@ -1,26 +1,50 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
-"""Compiled inner loops of the top-down beam Viterbi (see :mod:`skmotion.tree._decode`).
+"""Compiled top-down beam Viterbi (see :mod:`skmotion.tree._decode`).
 
 The recursions of a Viterbi pass run frame after frame, as they must; done in
-numpy they cost one Python step per frame and layer. Here one call handles one
-layer of every problem (a clip decoded under one graph): it forms each frame's
-candidates (the children of its kept nodes), their Gaussian log densities and
-the transition log probabilities between consecutive candidates, then runs the
-max-product pass that layer needs. The arithmetic is that of the numpy
-reference (:mod:`skmotion.tree._viterbi`): a step's score is ``move + emission``
-of the arriving node, added to the score so far, and ties go to the lower
-candidate slot (or rank, then slot).
+numpy they cost one Python step per frame and layer. Here one call decodes a
+group of *searches*, each one clip searched top-down under one graph (the
+guide, or a problem's own graph), layer after layer, with no Python between:
 
-Candidate slots of a frame: ``side * width + w`` is child ``side`` (0 left, 1
-right) of the frame's ``w``-th kept node; -1 is "no node".
+1. a frame's candidates at layer ``l`` are the children of its kept nodes at
+   ``l - 1`` (a leaf copied down has one child, itself);
+2. their Gaussian log densities (a copied leaf's is carried down, not recomputed);
+3. at a *scored* layer, every problem of the search (the clip under one graph)
+   runs its max-product pass over the candidates: the best sequence's score, or
+   the ``n_paths`` best sequences (list Viterbi), or first the best and then,
+   for the problems that may still win their clip, the list (``"prune"``);
+4. above the last layer, a max-product forward-backward pass under the search
+   graph scores each candidate by the best sequence through it, and each frame
+   keeps its ``n_paths`` best for the next layer.
+
+The arithmetic is that of the numpy reference (:mod:`skmotion.tree._viterbi`):
+a step's score is ``move + emission`` of the arriving node, added to the score
+so far, and ties go to the lower candidate slot (or rank, then slot). Slot
+``side * width + w`` of a frame is child ``side`` (0 left, 1 right) of its
+``w``-th kept node; -1 is "no node". Emissions are ``log Po(x | k)``; the
+normaliser of ``Ps`` is the same for every candidate of a frame, so the caller
+subtracts its per-clip sum from the scores.
 """
 
 import numpy as np
 
-from libc.math cimport INFINITY
+from libc.math cimport INFINITY, log
 from libc.stdlib cimport free, malloc
 
 ctypedef Py_ssize_t intp
+
+cdef extern from "_emission.h" nogil:
+    double skm_diag_maha(const double* x, const double* mu, const double* prec, Py_ssize_t d)
+    double skm_full_maha(const double* x, const double* factor, const double* shift, Py_ssize_t d, double* y)
+
+#: What a call computes per problem; see :func:`decode_searches`.
+MODES = ("beam", "best", "kbest", "prune")
+
+cdef enum:
+    BEAM = 0
+    BEST = 1
+    KBEST = 2
+    PRUNE = 3
 
 
 cdef struct Gaussians:
@@ -28,7 +52,6 @@ cdef struct Gaussians:
     const double* prec      # diag: (n_tree_nodes, d) precisions; full: (n_tree_nodes, d, d) upper factors
     const double* shifts    # full only: (n_tree_nodes, d), mean @ factor
     const double* const_    # (n_tree_nodes,)
-    const intp* ids         # layer index -> tree node id
     intp d
     bint full
 
@@ -43,56 +66,21 @@ cdef struct Table:
     intp n_graphs
 
 
-cdef struct Problem:
-    const double* frames    # the clip's first frame
-    intp n_steps
-    const intp* beam        # the clip's rows of the previous layer's beam, (n_steps, width)
-    intp width
-    intp graph
-    const unsigned char* allowed   # the graph's allowed nodes, or NULL for all
-    const double* norm      # per-frame normaliser to subtract, or NULL
-    intp norm_stride
+cdef struct Layer:
+    const intp* children    # (K_{l-1}, 2): layer indices here of the children of the layer above's nodes
+    const intp* ids         # (K_l,): layer index -> tree node id
+    Table search            # the search graphs' transitions
+    Table score             # the scored graphs' transitions
+    const unsigned char* search_allowed    # (n_search_graphs, K_l) nodes a search may visit, or NULL for all
+    const unsigned char* score_allowed     # (n_score_graphs, K_l) nodes a scored graph may visit, or NULL
+    intp k
 
 
-cdef inline double _emission(const Gaussians* g, const double* x, intp node, double* y) noexcept nogil:
-    """Log density of frame ``x`` under the node's Gaussian; ``y`` is scratch of ``d`` doubles.
-
-    Sums run in four independent parts: one running sum is a chain of
-    dependent additions that the compiler may not reorder, four keep the
-    processor's pipelines full.
-    """
-    cdef intp n = g.ids[node], d = g.d, a, b
-    cdef const double* p
-    cdef const double* mu
-    cdef double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0, xa
+cdef inline double _emission(const Gaussians* g, const double* x, intp n, double* y) noexcept nogil:
+    """Log density of frame ``x`` under tree node ``n``'s Gaussian; ``y`` is scratch of ``d`` doubles."""
     if g.full:
-        # y = x @ U - mean @ U, U upper triangular, row by row (contiguous and independent per column)
-        p = g.prec + n * d * d
-        mu = g.shifts + n * d
-        for b in range(d):
-            y[b] = -mu[b]
-        for a in range(d):
-            xa = x[a]
-            for b in range(a, d):
-                y[b] += xa * p[a * d + b]
-        for b in range(d):
-            y[b] = y[b] * y[b]
-    else:
-        p = g.prec + n * d
-        mu = g.means + n * d
-        for a in range(d):
-            y[a] = (x[a] - mu[a]) * (x[a] - mu[a]) * p[a]
-    a = 0
-    while a + 4 <= d:
-        s0 += y[a]
-        s1 += y[a + 1]
-        s2 += y[a + 2]
-        s3 += y[a + 3]
-        a += 4
-    while a < d:
-        s0 += y[a]
-        a += 1
-    return g.const_[n] - 0.5 * ((s0 + s1) + (s2 + s3))
+        return g.const_[n] - 0.5 * skm_full_maha(x, g.prec + n * g.d * g.d, g.shifts + n * g.d, g.d, y)
+    return g.const_[n] - 0.5 * skm_diag_maha(x, g.means + n * g.d, g.prec + n * g.d, g.d)
 
 
 cdef inline double _transition(const Table* t, intp graph, intp src, intp dst) noexcept nogil:
@@ -114,35 +102,6 @@ cdef inline double _transition(const Table* t, intp graph, intp src, intp dst) n
     return t.unseen[row]
 
 
-cdef void _candidates(const Problem* pb, const intp* children, intp* cand) noexcept nogil:
-    """Children of each frame's kept nodes, ``(n_steps, 2 * width)``; -1 for none or not allowed."""
-    cdef intp t, side, w, node, child, width = pb.width, n_cand = 2 * pb.width
-    for t in range(pb.n_steps):
-        for side in range(2):
-            for w in range(width):
-                node = pb.beam[t * width + w]
-                child = -1 if node < 0 else children[2 * node + side]
-                if child >= 0 and pb.allowed != NULL and not pb.allowed[child]:
-                    child = -1
-                cand[t * n_cand + side * width + w] = child
-
-
-cdef void _emissions(const Problem* pb, const Gaussians* g, const intp* cand, intp n_cand, double* emit,
-                     double* y) noexcept nogil:
-    cdef intp t, c, node
-    cdef const double* x
-    for t in range(pb.n_steps):
-        x = pb.frames + t * g.d
-        for c in range(n_cand):
-            node = cand[t * n_cand + c]
-            if node < 0:
-                emit[t * n_cand + c] = -INFINITY
-            else:
-                emit[t * n_cand + c] = _emission(g, x, node, y)
-                if pb.norm != NULL:
-                    emit[t * n_cand + c] -= pb.norm[t * pb.norm_stride]
-
-
 cdef bint _same_row(const intp* a, const intp* b, intp n) noexcept nogil:
     cdef intp i
     for i in range(n):
@@ -151,7 +110,7 @@ cdef bint _same_row(const intp* a, const intp* b, intp n) noexcept nogil:
     return True
 
 
-cdef void _steps(const Problem* pb, const Table* tab, const intp* cand, const double* emit, intp n_cand,
+cdef void _steps(intp n_steps, intp n_cand, const Table* tab, intp graph, const intp* cand, const double* emit,
                  double* moves, double* steps) noexcept nogil:
     """``steps[t, i, j]``: move from slot ``i`` at ``t`` to slot ``j`` at ``t + 1``, plus ``j``'s emission.
 
@@ -162,13 +121,13 @@ cdef void _steps(const Problem* pb, const Table* tab, const intp* cand, const do
     cdef double* row
     cdef const double* move
     cdef const double* base
-    for t in range(pb.n_steps - 1):
+    for t in range(n_steps - 1):
         if t == 0 or not (_same_row(cand + t * n_cand, cand + (t - 1) * n_cand, n_cand)
                           and _same_row(cand + (t + 1) * n_cand, cand + t * n_cand, n_cand)):
             if tab.dense != NULL:  # no search and no branch: "no node" is row and column K, -inf
                 for i in range(n_cand):
                     src = cand[t * n_cand + i]
-                    base = tab.dense + (tab.k if src < 0 else src) * (tab.k + 1) * tab.n_graphs + pb.graph
+                    base = tab.dense + (tab.k if src < 0 else src) * (tab.k + 1) * tab.n_graphs + graph
                     for j in range(n_cand):
                         dst = cand[(t + 1) * n_cand + j]
                         moves[i * n_cand + j] = base[(tab.k if dst < 0 else dst) * tab.n_graphs]
@@ -176,7 +135,7 @@ cdef void _steps(const Problem* pb, const Table* tab, const intp* cand, const do
                 for i in range(n_cand):
                     src = cand[t * n_cand + i]
                     for j in range(n_cand):
-                        moves[i * n_cand + j] = _transition(tab, pb.graph, src, cand[(t + 1) * n_cand + j])
+                        moves[i * n_cand + j] = _transition(tab, graph, src, cand[(t + 1) * n_cand + j])
         for i in range(n_cand):
             row = steps + (t * n_cand + i) * n_cand
             move = moves + i * n_cand
@@ -253,15 +212,17 @@ cdef double _best(intp n_steps, intp n_cand, const double* emit, const double* s
 cdef void _kbest(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const double* emit,
                  const double* steps, double* delta, double* scratch, intp* head, intp* back, intp* paths,
                  intp path_stride, double* scores) noexcept nogil:
-    """List Viterbi: the ``n_paths`` best slot sequences, as node paths (rows of -1 stay for missing ones).
+    """List Viterbi: the ``n_paths`` best slot sequences' scores and, unless ``paths`` is NULL, their node paths.
 
-    ``head`` is scratch of ``n_cand``: the rank of each slot's next unpicked entry.
+    ``head`` is scratch of ``n_cand``: the rank of each slot's next unpicked
+    entry. Rows of ``paths`` stay as they are for missing sequences.
     """
     cdef intp t, r, r2, i, j, e, arg, rank, state, n_entries = n_paths * n_cand
     cdef double best
     cdef double* prev = delta
     cdef double* cur = delta + n_entries
     cdef double* tmp
+    cdef bint track = paths != NULL
     # prev[r * n_cand + j]: the rank-r sequence ending in slot j (decreasing in r)
     for e in range(n_entries):
         prev[e] = emit[e] if e < n_cand else -INFINITY
@@ -284,14 +245,16 @@ cdef void _kbest(intp n_steps, intp n_cand, intp n_paths, const intp* cand, cons
                 if arg < 0:  # only -inf left: no sequence of this rank
                     for r2 in range(r, n_paths):
                         cur[r2 * n_cand + j] = -INFINITY
-                        back[(t * n_paths + r2) * n_cand + j] = 0
+                        if track:
+                            back[(t * n_paths + r2) * n_cand + j] = 0
                     break
                 # among equal heads the lowest entry: the lowest rank, then the lowest slot
                 for i in range(n_cand):
                     if head[i] < n_paths and scratch[i] == best and head[i] * n_cand + i < head[arg] * n_cand + arg:
                         arg = i
                 cur[r * n_cand + j] = best
-                back[(t * n_paths + r) * n_cand + j] = head[arg] * n_cand + arg
+                if track:
+                    back[(t * n_paths + r) * n_cand + j] = head[arg] * n_cand + arg
                 head[arg] += 1
                 if head[arg] < n_paths:
                     scratch[arg] = prev[head[arg] * n_cand + arg] + steps[((t - 1) * n_cand + arg) * n_cand + j]
@@ -302,7 +265,7 @@ cdef void _kbest(intp n_steps, intp n_cand, intp n_paths, const intp* cand, cons
         scratch[e] = prev[e]
     for r in range(n_paths):
         e = _pick(scratch, n_entries, &scores[r])
-        if scores[r] == -INFINITY:
+        if scores[r] == -INFINITY or not track:
             continue
         rank = e // n_cand
         state = e % n_cand
@@ -314,7 +277,7 @@ cdef void _kbest(intp n_steps, intp n_cand, intp n_paths, const intp* cand, cons
                 state = e % n_cand
 
 
-cdef Gaussians _gaussians(object gauss, const intp[::1] ids):
+cdef Gaussians _gaussians(object gauss):
     cdef Gaussians g
     cdef const double[:, ::1] means = gauss["means"]
     cdef const double[::1] prec = gauss["prec"]
@@ -324,7 +287,6 @@ cdef Gaussians _gaussians(object gauss, const intp[::1] ids):
     g.prec = &prec[0]
     g.shifts = &shifts[0, 0]
     g.const_ = &const_[0]
-    g.ids = &ids[0]
     g.d = means.shape[1]
     g.full = gauss["full"]
     return g
@@ -347,147 +309,330 @@ cdef Table _table(object table):
     return t
 
 
-def descend_layer(const double[:, ::1] frames, const intp[::1] frame_start, const intp[::1] n_steps,
-                  const intp[:, ::1] beam, const intp[::1] beam_start, const intp[::1] graph,
-                  const intp[:, ::1] children, const unsigned char[:, ::1] allowed, object gauss,
-                  const intp[::1] ids, object table, intp n_paths):
-    """One layer down: the new per-frame beam of every problem.
+cdef const unsigned char* _mask(const unsigned char[:, ::1] allowed):
+    return &allowed[0, 0] if allowed.shape[0] else NULL
 
-    Problem ``p`` decodes frames ``frame_start[p] : frame_start[p] + n_steps[p]``
-    under graph ``graph[p]``; its rows of ``beam`` (the kept nodes of the layer
-    above, ``(n_rows, width)``, -1 for none) start at ``beam_start[p]``, and so
-    do its rows of the result. A frame keeps the ``n_paths`` candidates with the
-    best max-marginal (best first, ties to the lower slot; -1 for candidates of
-    no finite score); with ``2 * width <= n_paths`` it keeps them all unscored.
 
-    ``allowed`` is ``(n_graphs, K)``, or ``(0, 0)`` for every node. ``gauss`` and
-    ``table`` come from :meth:`MotionTree.kernel_gaussians` and
-    :meth:`TransitionGraphs.kernel_table`.
+cdef Layer _layer(object spec):
+    cdef Layer out
+    cdef const intp[:, ::1] children = spec[0]
+    cdef const intp[::1] ids = spec[1]
+    out.children = &children[0, 0]
+    out.ids = &ids[0]
+    out.k = ids.shape[0]
+    out.search = _table(spec[2])
+    out.score = _table(spec[3])
+    out.search_allowed = _mask(spec[4])
+    out.score_allowed = _mask(spec[5])
+    return out
+
+
+cdef struct Work:
+    # per frame of the longest clip, at most 2 n_paths candidates (the root has 1 kept node, then n_paths)
+    intp* beam          # (T, n_paths) kept nodes of the layer above
+    intp* next_beam
+    double* beam_emit   # (T, n_paths) their emissions, when known
+    double* next_emit
+    intp* cand          # (slots, T, 2 n_paths) candidates of each stored layer
+    double* emit        # (slots, T, 2 n_paths) their emissions
+    double* masked      # (T, 2 n_paths) emissions with a scored graph's forbidden nodes at -inf
+    double* steps       # (T, 2 n_paths, 2 n_paths)
+    double* fwd
+    double* bwd
+    double* moves
+    double* delta
+    double* scratch
+    intp* head
+    intp* back          # (T, n_paths, 2 n_paths), or NULL when no paths are wanted
+    double* y           # (d,)
+
+
+cdef void _free_work(Work* w) noexcept:
+    free(w.beam); free(w.next_beam); free(w.beam_emit); free(w.next_emit); free(w.cand); free(w.emit)
+    free(w.masked); free(w.steps); free(w.fwd); free(w.bwd); free(w.moves); free(w.delta); free(w.scratch)
+    free(w.head); free(w.back); free(w.y)
+
+
+cdef bint _alloc_work(Work* w, intp max_steps, intp n_paths, intp slots, intp d, bint paths) noexcept:
+    cdef intp t = max(max_steps, 1), nc = 2 * n_paths
+    w.beam = <intp*> malloc(t * n_paths * sizeof(intp))
+    w.next_beam = <intp*> malloc(t * n_paths * sizeof(intp))
+    w.beam_emit = <double*> malloc(t * n_paths * sizeof(double))
+    w.next_emit = <double*> malloc(t * n_paths * sizeof(double))
+    w.cand = <intp*> malloc(slots * t * nc * sizeof(intp))
+    w.emit = <double*> malloc(slots * t * nc * sizeof(double))
+    w.masked = <double*> malloc(t * nc * sizeof(double))
+    w.steps = <double*> malloc(t * nc * nc * sizeof(double))
+    w.fwd = <double*> malloc(t * nc * sizeof(double))
+    w.bwd = <double*> malloc(t * nc * sizeof(double))
+    w.moves = <double*> malloc(nc * nc * sizeof(double))
+    w.delta = <double*> malloc(2 * n_paths * nc * sizeof(double))
+    w.scratch = <double*> malloc(n_paths * nc * sizeof(double))
+    w.head = <intp*> malloc(nc * sizeof(intp))
+    w.back = <intp*> malloc(t * n_paths * nc * sizeof(intp)) if paths else NULL
+    w.y = <double*> malloc(max(d, 1) * sizeof(double))
+    return not (w.beam == NULL or w.next_beam == NULL or w.beam_emit == NULL or w.next_emit == NULL
+                or w.cand == NULL or w.emit == NULL or w.masked == NULL or w.steps == NULL or w.fwd == NULL
+                or w.bwd == NULL or w.moves == NULL or w.delta == NULL or w.scratch == NULL or w.head == NULL
+                or (paths and w.back == NULL) or w.y == NULL)
+
+
+cdef intp _candidates(const Layer* lay, intp n_steps, intp width, intp search_graph,
+                      bint carry, const Gaussians* g, const double* frames, Work* w, intp* cand, double* emit,
+                      bint emissions) noexcept nogil:
+    """Each frame's candidates (children of its kept nodes) and, with ``emissions``, their log densities.
+
+    A leaf copied down is its own only child: with ``carry`` (the kept nodes'
+    emissions are known) its emission is carried, not recomputed. Returns the
+    candidates per frame.
     """
-    cdef intp width = beam.shape[1], n_cand = 2 * width, n_problems = frame_start.shape[0]
-    cdef intp keep = min(n_paths, n_cand), max_steps = 0, p, t, c, r
+    cdef intp t, side, j, node, child, n_cand = 2 * width
+    cdef const unsigned char* allowed = (lay.search_allowed + search_graph * lay.k
+                                         if lay.search_allowed != NULL else NULL)
+    for t in range(n_steps):
+        for side in range(2):
+            for j in range(width):
+                node = w.beam[t * width + j]
+                child = -1 if node < 0 else lay.children[2 * node + side]
+                if child >= 0 and allowed != NULL and not allowed[child]:
+                    child = -1
+                cand[t * n_cand + side * width + j] = child
+                if not emissions:
+                    continue
+                if child < 0:
+                    emit[t * n_cand + side * width + j] = -INFINITY
+                elif carry and side == 0 and lay.children[2 * node + 1] < 0:
+                    emit[t * n_cand + j] = w.beam_emit[t * width + j]
+                else:
+                    emit[t * n_cand + side * width + j] = _emission(g, frames + t * g.d, lay.ids[child], w.y)
+    return n_cand
+
+
+cdef intp _keep(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const double* emit, bint have_emit,
+                const Table* tab, intp graph, Work* w) noexcept nogil:
+    """The next layer's beam (``w.next_beam``, ``w.next_emit``): each frame's ``n_paths`` best candidates.
+
+    Best max-marginal first, ties to the lower slot, -1 for candidates of no
+    finite score; with ``n_cand <= n_paths`` all are kept, unscored (and their
+    emissions carried when ``have_emit``). Returns the new width.
+    """
+    cdef intp t, c, r, keep
     cdef double v
-    cdef Gaussians g = _gaussians(gauss, ids)
-    cdef Table tab = _table(table)
-    out_array = np.full((beam.shape[0], keep), -1, dtype=np.intp)
-    cdef intp[:, ::1] out = out_array
-    cdef Problem pb
-    for p in range(n_problems):
-        max_steps = max(max_steps, n_steps[p])
-    cdef intp* cand = <intp*> malloc(max(max_steps * n_cand, 1) * sizeof(intp))
-    cdef double* emit = <double*> malloc(max(max_steps * n_cand, 1) * sizeof(double))
-    cdef double* steps = <double*> malloc(max(max_steps * n_cand * n_cand, 1) * sizeof(double))
-    cdef double* fwd = <double*> malloc(max(max_steps * n_cand, 1) * sizeof(double))
-    cdef double* bwd = <double*> malloc(max(max_steps * n_cand, 1) * sizeof(double))
-    cdef double* moves = <double*> malloc(n_cand * n_cand * sizeof(double))
-    cdef double* y = <double*> malloc(g.d * sizeof(double))
-    if cand == NULL or emit == NULL or steps == NULL or fwd == NULL or bwd == NULL or moves == NULL or y == NULL:
-        free(cand); free(emit); free(steps); free(fwd); free(bwd); free(moves); free(y)
-        raise MemoryError(f"decoding {max_steps} frames with {n_cand} candidates each")
-    try:
-        with nogil:
-            for p in range(n_problems):
-                if n_steps[p] == 0:
-                    continue
-                pb.frames = &frames[frame_start[p], 0]
-                pb.n_steps = n_steps[p]
-                pb.beam = &beam[beam_start[p], 0]
-                pb.width = width
-                pb.graph = graph[p]
-                pb.allowed = &allowed[graph[p], 0] if allowed.shape[0] else NULL
-                pb.norm = NULL
-                _candidates(&pb, &children[0, 0], cand)
-                if n_cand <= n_paths:
-                    for t in range(pb.n_steps):
-                        for c in range(n_cand):
-                            out[beam_start[p] + t, c] = cand[t * n_cand + c]
-                    continue
-                _emissions(&pb, &g, cand, n_cand, emit, y)
-                _steps(&pb, &tab, cand, emit, n_cand, moves, steps)
-                _max_marginals(pb.n_steps, n_cand, emit, steps, fwd, bwd)
-                for t in range(pb.n_steps):
-                    for c in range(n_cand):
-                        fwd[t * n_cand + c] += bwd[t * n_cand + c]
-                    for r in range(keep):
-                        c = _pick(fwd + t * n_cand, n_cand, &v)
-                        out[beam_start[p] + t, r] = cand[t * n_cand + c] if v > -INFINITY else -1
-    finally:
-        free(cand); free(emit); free(steps); free(fwd); free(bwd); free(moves); free(y)
-    return out_array
+    if n_cand <= n_paths:
+        for t in range(n_steps * n_cand):
+            w.next_beam[t] = cand[t]
+            if have_emit:
+                w.next_emit[t] = emit[t]
+        return n_cand
+    keep = n_paths
+    _steps(n_steps, n_cand, tab, graph, cand, emit, w.moves, w.steps)
+    _max_marginals(n_steps, n_cand, emit, w.steps, w.fwd, w.bwd)
+    for t in range(n_steps):
+        for c in range(n_cand):
+            w.fwd[t * n_cand + c] += w.bwd[t * n_cand + c]
+        for r in range(keep):
+            c = _pick(w.fwd + t * n_cand, n_cand, &v)
+            w.next_beam[t * keep + r] = cand[t * n_cand + c] if v > -INFINITY else -1
+            w.next_emit[t * keep + r] = emit[t * n_cand + c]
+    return keep
 
 
-def kbest_layer(const double[:, ::1] frames, const intp[::1] frame_start, const intp[::1] n_steps,
-                const intp[:, ::1] beam, const intp[::1] beam_start, const intp[::1] graph,
-                const intp[:, ::1] children, const unsigned char[:, ::1] allowed, object gauss,
-                const intp[::1] ids, object table, const double[:, ::1] norm, const intp[::1] norm_col,
-                intp n_paths, bint best_only):
-    """The last layer: the ``n_paths`` best node sequences of every problem, or only the best score.
+cdef void _score(intp mode, intp n_steps, intp n_cand, intp n_paths, const Layer* lay, intp graph,
+                 const intp* cand, const double* emit, Work* w, double* scores, intp* paths,
+                 intp path_stride) noexcept nogil:
+    """One problem at one scored layer: its best score (``BEST``) or its ``n_paths`` best sequences."""
+    cdef intp i
+    cdef const unsigned char* allowed
+    if lay.score_allowed != NULL:  # the graph's prior leaves its unvisited nodes out
+        allowed = lay.score_allowed + graph * lay.k
+        for i in range(n_steps * n_cand):
+            w.masked[i] = emit[i] if cand[i] >= 0 and allowed[cand[i]] else -INFINITY
+        emit = w.masked
+    _steps(n_steps, n_cand, &lay.score, graph, cand, emit, w.moves, w.steps)
+    if mode == BEST:
+        scores[0] = _best(n_steps, n_cand, emit, w.steps, w.fwd)
+    else:
+        _kbest(n_steps, n_cand, n_paths, cand, emit, w.steps, w.delta, w.scratch, w.head, w.back, paths,
+               path_stride, scores)
 
-    Problems as for :func:`descend_layer`. ``norm`` is ``(n_frames, n_columns)``,
-    the log normaliser of ``Ps`` subtracted from the emissions (column
-    ``norm_col[p]`` for problem ``p``), or ``(0, 0)`` for none.
+
+def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, const intp[::1] n_steps,
+                    const intp[::1] search_graph, const intp[::1] problem_start, const intp[::1] score_graph,
+                    object gauss, list layers, intp first_scored, intp n_paths, str mode, bint want_paths):
+    """Decode searches top-down through ``len(layers) - 1`` layers, scoring the last ones.
+
+    Search ``s`` decodes frames ``frame_start[s] : frame_start[s] + n_steps[s]``
+    under graph ``search_graph[s]`` of the search tables; its problems are
+    ``problem_start[s] : problem_start[s + 1]``, problem ``p`` the same clip under
+    graph ``score_graph[p]`` of the scored tables.
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, d)
+    frame_start, n_steps, search_graph : ndarray of shape (n_searches,)
+    problem_start : ndarray of shape (n_searches + 1,)
+    score_graph : ndarray of shape (n_problems,)
+    gauss : dict
+        :meth:`MotionTree.kernel_gaussians`.
+    layers : list
+        Entry ``l`` (1 to ``L``; entry 0 is unused) is ``(children, ids,
+        search_table, score_table, search_allowed, score_allowed)``: the
+        children in layer ``l`` of the nodes of ``l - 1`` (``MotionTree.children``),
+        the layer's tree node ids, two :meth:`TransitionGraphs.kernel_table`, and
+        the allowed-node masks ``(n_graphs, K_l)`` of uint8, or ``(0, 0)`` for all nodes.
+    first_scored : int
+        Layers ``first_scored .. L`` are scored (``1 <= first_scored <= L``).
+    n_paths : int
+        Nodes kept per frame, and sequences per problem.
+    mode : {"beam", "best", "kbest", "prune"}
+        ``"beam"``: no scoring; return each frame's kept nodes at layer ``L``.
+        ``"best"``: the best sequence's score at each scored layer. ``"kbest"``:
+        the ``n_paths`` best sequences. ``"prune"``: the best first; then the
+        list only for the problems whose summed best scores plus
+        ``n_scored log(n_paths)`` reach the best sum of their search (the
+        others cannot hold the highest summed probability and get ``-inf``); a
+        search left with one such problem keeps its best scores alone.
+    want_paths : bool
+        Return the node paths at layer ``L`` (``"kbest"`` and ``"prune"``).
 
     Returns
     -------
-    paths : ndarray of shape (n_problems, n_paths, max(n_steps))
-        Node sequences, best first; -1 past a problem's length and for missing
-        sequences. Not computed (all -1) with ``best_only``.
-    scores : ndarray of shape (n_problems, n_paths)
-        Their log scores (``-inf`` for missing ones); with ``best_only`` the
-        first column holds the best sequence's score and the others ``-inf``.
+    scores : ndarray of shape (n_problems, n_scored, n_paths)
+        Log scores (``log Po`` emissions, no normaliser), best first; ``-inf``
+        for missing sequences. Empty for ``"beam"``.
+    paths : ndarray of shape (n_problems, n_paths, max(n_steps)) or None
+        Node sequences at layer ``L``; -1 past a clip's length and for missing ones.
+    beam : ndarray of shape (sum(n_steps), width) or None
+        ``"beam"`` only: each frame's kept nodes at layer ``L`` (search after
+        search), -1 for none.
     """
-    cdef intp width = beam.shape[1], n_cand = 2 * width, n_problems = frame_start.shape[0]
-    cdef intp max_steps = 0, p
-    cdef Gaussians g = _gaussians(gauss, ids)
-    cdef Table tab = _table(table)
-    for p in range(n_problems):
-        max_steps = max(max_steps, n_steps[p])
-    paths_array = np.full((n_problems, n_paths, max_steps), -1, dtype=np.intp)
-    scores_array = np.full((n_problems, n_paths), -np.inf)
-    cdef intp[:, :, ::1] paths = paths_array
-    cdef double[:, ::1] scores = scores_array
-    cdef Problem pb
-    cdef bint same
-    cdef intp size = max(max_steps * n_cand, 1)
-    cdef intp* cand = <intp*> malloc(size * sizeof(intp))
-    cdef double* emit = <double*> malloc(size * sizeof(double))
-    cdef double* steps = <double*> malloc(size * n_cand * sizeof(double))
-    cdef double* delta = <double*> malloc(2 * max(n_paths * n_cand, 1) * sizeof(double))
-    cdef double* scratch = <double*> malloc(max(n_paths * n_cand, 1) * sizeof(double))
-    cdef intp* back = <intp*> malloc(size * n_paths * sizeof(intp))
-    cdef intp* head = <intp*> malloc(max(n_cand, 1) * sizeof(intp))
-    cdef double* moves = <double*> malloc(n_cand * n_cand * sizeof(double))
-    cdef double* y = <double*> malloc(g.d * sizeof(double))
-    if (cand == NULL or emit == NULL or steps == NULL or delta == NULL or scratch == NULL or back == NULL
-            or head == NULL or moves == NULL or y == NULL):
-        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(head); free(moves); free(y)
-        raise MemoryError(f"decoding {max_steps} frames with {n_cand} candidates each")
+    if mode not in MODES:
+        raise ValueError(f"mode must be one of {MODES}; got {mode!r}.")
+    cdef intp imode = MODES.index(mode)
+    cdef intp n_layers = len(layers) - 1, n_searches = frame_start.shape[0]
+    cdef intp n_problems = score_graph.shape[0]
+    cdef intp n_scored = 0 if imode == BEAM else n_layers - first_scored + 1
+    cdef intp max_steps = 0, total_steps = 0, s, p, l, t, r, li, width, n_cand, slot, n_live
+    cdef intp slots = 1 + (n_scored if imode == PRUNE else 0)
+    cdef double top, margin
+    cdef bint carry, scored, need, paths_now
+    if n_layers < 1 or (imode != BEAM and not 1 <= first_scored <= n_layers):
+        raise ValueError(f"need 1 <= first_scored <= {n_layers} layers; got {first_scored}.")
+    for s in range(n_searches):
+        max_steps = max(max_steps, n_steps[s])
+        total_steps += n_steps[s]
+    cdef Gaussians g = _gaussians(gauss)
+    cdef Layer* lays = <Layer*> malloc((n_layers + 1) * sizeof(Layer))
+    if lays == NULL:
+        raise MemoryError("decoding layers")
+    for l in range(1, n_layers + 1):
+        lays[l] = _layer(layers[l])
+    scores_array = np.full((n_problems, n_scored, n_paths), -np.inf)
+    cdef double[:, :, ::1] scores = scores_array
+    paths_array = None
+    cdef intp[:, :, ::1] paths
+    want_paths = want_paths and imode in (KBEST, PRUNE)
+    if want_paths:
+        paths_array = np.full((n_problems, n_paths, max_steps), -1, dtype=np.intp)
+        paths = paths_array
+    beam_array = None
+    cdef intp[:, ::1] beam_out
+    cdef intp* best_widths = <intp*> malloc((n_scored + 1) * sizeof(intp))
+    cdef double* best_sum = <double*> malloc(max(n_problems, 1) * sizeof(double))
+    cdef bint* live = <bint*> malloc(max(n_problems, 1) * sizeof(bint))
+    cdef Work w
+    cdef bint ok = _alloc_work(&w, max_steps, n_paths, slots, g.d, want_paths)
+    if not ok or best_widths == NULL or best_sum == NULL or live == NULL:
+        _free_work(&w); free(lays); free(best_widths); free(best_sum); free(live)
+        raise MemoryError(f"decoding {max_steps} frames with {2 * n_paths} candidates each")
+    cdef intp* cand
+    cdef double* emit
+    cdef intp* tmp_i
+    cdef double* tmp_d
+    cdef intp out_row = 0
     try:
         with nogil:
-            for p in range(n_problems):
-                if n_steps[p] == 0:
+            for s in range(n_searches):
+                if n_steps[s] == 0:
                     continue
-                pb.frames = &frames[frame_start[p], 0]
-                pb.n_steps = n_steps[p]
-                pb.beam = &beam[beam_start[p], 0]
-                pb.width = width
-                pb.graph = graph[p]
-                pb.allowed = &allowed[graph[p], 0] if allowed.shape[0] else NULL
-                pb.norm = &norm[frame_start[p], norm_col[p]] if norm.shape[0] else NULL
-                pb.norm_stride = norm.shape[1]
-                # Problems of one clip in a row share its candidates and emissions.
-                same = (p > 0 and pb.allowed == NULL and frame_start[p] == frame_start[p - 1]
-                        and n_steps[p] == n_steps[p - 1] and beam_start[p] == beam_start[p - 1]
-                        and (pb.norm == NULL or norm_col[p] == norm_col[p - 1]))
-                if not same:
-                    _candidates(&pb, &children[0, 0], cand)
-                    _emissions(&pb, &g, cand, n_cand, emit, y)
-                _steps(&pb, &tab, cand, emit, n_cand, moves, steps)
-                if best_only:
-                    scores[p, 0] = _best(pb.n_steps, n_cand, emit, steps, delta)
-                else:
-                    _kbest(pb.n_steps, n_cand, n_paths, cand, emit, steps, delta, scratch, head, back,
-                           &paths[p, 0, 0], max_steps, &scores[p, 0])
+                for t in range(n_steps[s]):
+                    w.beam[t] = 0  # layer 0: the root
+                width = 1
+                carry = False
+                for p in range(problem_start[s], problem_start[s + 1]):
+                    best_sum[p] = 0.0
+                for l in range(1, n_layers + 1):
+                    scored = imode != BEAM and l >= first_scored
+                    li = l - first_scored
+                    slot = 1 + li if (scored and imode == PRUNE) else 0
+                    cand = w.cand + slot * max_steps * 2 * n_paths
+                    emit = w.emit + slot * max_steps * 2 * n_paths
+                    # emissions are needed to score this layer or to choose among its candidates
+                    need = scored or (2 * width > n_paths and (l < n_layers or imode == BEAM))
+                    n_cand = _candidates(&lays[l], n_steps[s], width, search_graph[s], carry, &g,
+                                         &frames[frame_start[s], 0], &w, cand, emit, need)
+                    if scored:
+                        best_widths[li] = n_cand
+                        paths_now = want_paths and l == n_layers and imode == KBEST
+                        for p in range(problem_start[s], problem_start[s + 1]):
+                            _score(BEST if imode == PRUNE else imode, n_steps[s], n_cand, n_paths, &lays[l],
+                                   score_graph[p], cand, emit, &w, &scores[p, li, 0],
+                                   &paths[p, 0, 0] if paths_now else NULL, max_steps)
+                            if imode == PRUNE:
+                                best_sum[p] += scores[p, li, 0]
+                    if l < n_layers or imode == BEAM:
+                        width = _keep(n_steps[s], n_cand, n_paths, cand, emit, need, &lays[l].search,
+                                      search_graph[s], &w)
+                        carry = need
+                        tmp_i = w.beam
+                        w.beam = w.next_beam
+                        w.next_beam = tmp_i
+                        tmp_d = w.beam_emit
+                        w.beam_emit = w.next_emit
+                        w.next_emit = tmp_d
+                if imode == BEAM:
+                    with gil:
+                        if beam_array is None:
+                            beam_array = np.full((total_steps, width), -1, dtype=np.intp)
+                            beam_out = beam_array
+                    for t in range(n_steps[s]):
+                        for r in range(width):
+                            beam_out[out_row + t, r] = w.beam[t * width + r]
+                    out_row += n_steps[s]
+                    continue
+                if imode != PRUNE:
+                    continue
+                # The sum of n_paths sequences lies between the best one and n_paths times it, at each layer.
+                top = -INFINITY
+                for p in range(problem_start[s], problem_start[s + 1]):
+                    top = max(top, best_sum[p])
+                margin = n_scored * log(<double> n_paths)
+                n_live = 0
+                for p in range(problem_start[s], problem_start[s + 1]):
+                    # kept with a margin for rounding in the sums of n_paths terms
+                    live[p] = best_sum[p] + margin >= top - 1e-9 * abs(top)
+                    n_live += live[p]
+                    if not live[p]:
+                        for li in range(n_scored):
+                            scores[p, li, 0] = -INFINITY
+                if n_live == 1:  # the winner: its best scores alone
+                    continue
+                for p in range(problem_start[s], problem_start[s + 1]):
+                    if not live[p]:
+                        continue
+                    for li in range(n_scored):
+                        l = first_scored + li
+                        paths_now = want_paths and l == n_layers
+                        _score(KBEST, n_steps[s], best_widths[li], n_paths, &lays[l], score_graph[p],
+                               w.cand + (1 + li) * max_steps * 2 * n_paths,
+                               w.emit + (1 + li) * max_steps * 2 * n_paths, &w, &scores[p, li, 0],
+                               &paths[p, 0, 0] if paths_now else NULL, max_steps)
     finally:
-        free(cand); free(emit); free(steps); free(delta); free(scratch); free(back); free(head); free(moves); free(y)
-    return paths_array, scores_array
+        _free_work(&w)
+        free(lays)
+        free(best_widths)
+        free(best_sum)
+        free(live)
+    if imode == BEAM and beam_array is None:
+        beam_array = np.full((total_steps, 1), -1, dtype=np.intp)
+    return scores_array, paths_array, beam_array

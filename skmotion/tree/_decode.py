@@ -16,10 +16,12 @@ its kept nodes. :func:`exhaustive_viterbi` searches all nodes of a layer, for
 reference and small problems.
 """
 
+from numbers import Integral
+
 import numpy as np
 from scipy.special import logsumexp
 
-from skmotion.tree._beam import descend_layer, kbest_layer
+from skmotion.tree._beam import decode_searches
 from skmotion.tree._viterbi import kbest_viterbi
 
 __all__ = ["NODE_PRIORS", "beam_decode", "exhaustive_viterbi", "node_log_posterior"]
@@ -139,41 +141,73 @@ def exhaustive_viterbi(tree, graphs, layer, frames, graph=0, *, n_paths=1, node_
 def _kernel_allowed(graphs, layer, node_prior):
     """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``, or ``(0, 0)`` for every node."""
     if node_prior == "layer":
-        return np.zeros((0, 0), dtype=np.uint8)
+        return _ALL_NODES
     return np.ascontiguousarray(_allowed_nodes(graphs, layer, node_prior), dtype=np.uint8)
 
 
-def _children(tree, layer):
-    return np.ascontiguousarray(tree.children(layer))
+_ALL_NODES = np.zeros((0, 0), dtype=np.uint8)
+
+
+def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
+    """What the compiled decoder reads of layers ``1 .. layer`` (entry 0 unused); see ``decode_searches``."""
+    specs = [None]
+    for depth in range(1, layer + 1):
+        specs.append((tree.kernel_children(depth - 1), tree.node_ids(depth), search.kernel_table(depth),
+                      scored.kernel_table(depth), _kernel_allowed(search, depth, node_prior),
+                      _kernel_allowed(scored, depth, node_prior) if mask_scored else _ALL_NODES))
+    return specs
 
 
 def _descend(tree, graphs, frames, frame_start, n_steps, graph, *, layer, n_paths, node_prior):
     """Each frame's ``n_paths`` best nodes at ``layer``, ``(sum(n_steps), width)``; -1 for none.
 
-    Problem ``p``'s rows start at ``cumsum(n_steps)[p - 1]``.
+    Search ``s`` decodes ``n_steps[s]`` frames from ``frame_start[s]`` under
+    graph ``graph[s]``; its rows follow those of the searches before it.
     """
-    rows = np.concatenate([[0], np.cumsum(n_steps)[:-1]]).astype(np.intp)
-    beam = np.zeros((int(np.sum(n_steps)), 1), dtype=np.intp)  # layer 0: the root
-    gauss = tree.kernel_gaussians()
-    for depth in range(1, layer + 1):
-        beam = descend_layer(frames, frame_start, n_steps, beam, rows, graph, _children(tree, depth - 1),
-                             _kernel_allowed(graphs, depth, node_prior), gauss, tree.node_ids(depth),
-                             graphs.kernel_table(depth), n_paths)
-    return beam, rows
+    n_steps = np.asarray(n_steps, dtype=np.intp)
+    if layer == 0:
+        return np.zeros((int(n_steps.sum()), 1), dtype=np.intp)
+    specs = _layer_specs(tree, graphs, graphs, layer, node_prior, False)
+    _, _, beam = decode_searches(
+        np.ascontiguousarray(frames, dtype=np.float64), np.asarray(frame_start, dtype=np.intp), n_steps,
+        np.asarray(graph, dtype=np.intp), np.zeros(len(n_steps) + 1, dtype=np.intp), np.zeros(0, dtype=np.intp),
+        tree.kernel_gaussians(), specs, 1, n_paths, "beam", False,
+    )
+    return beam
+
+
+def _clip_normalisers(tree, graphs, frames, offsets, clips, layers, node_prior):
+    """``sum_t log sum_j Po(x_t | j) P(j)`` of each clip, per layer and graph column: ``(n_layers, n_clips, n_cols)``.
+
+    Only the frames of ``clips`` are evaluated.
+    """
+    starts, lengths = offsets[clips], offsets[clips + 1] - offsets[clips]
+    rows = np.repeat(starts - np.concatenate([[0], np.cumsum(lengths)[:-1]]), lengths) + np.arange(lengths.sum())
+    sub = frames[rows]
+    bounds = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+    out = []
+    for depth in layers:
+        norm = _log_normaliser(tree.log_likelihood(sub, depth), _allowed_nodes(graphs, depth, node_prior))
+        sums = np.zeros((len(clips), norm.shape[1]))
+        has = lengths > 0
+        sums[has] = np.add.reduceat(norm, bounds[has], axis=0)
+        out.append(sums)
+    return np.array(out)
 
 
 def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, *, layer, n_paths=5,
-                node_prior="graph", guide=None, normalise=True, prune=False):
+                score_layers=1, node_prior="graph", guide=None, normalise=True, prune=False, return_paths=True):
     """Top-down beam Viterbi: the best node sequences of clips under graphs, layer by layer.
 
     Every frame starts at the root. Going one layer down, a frame's candidates
     are the children of its kept nodes; a max-product forward-backward pass over
     these candidates scores each by the best sequence through it, and the
     ``n_paths`` best of every frame are kept: a per-frame beam, the best
-    sequences through ``n_paths`` distinct nodes at each frame. At ``layer``, a
-    K-best Viterbi pass over the candidates gives the ``n_paths`` best
-    sequences. With ``n_paths`` at least the number of nodes of every layer
-    nothing is pruned, and the result is that of :func:`exhaustive_viterbi`.
+    sequences through ``n_paths`` distinct nodes at each frame. At the scored
+    layers (``layer`` and the ``score_layers - 1`` above it), a K-best Viterbi
+    pass over the candidates gives the ``n_paths`` best sequences. With
+    ``n_paths`` at least the number of nodes of every layer nothing is pruned,
+    and the result is that of :func:`exhaustive_viterbi` at each scored layer.
 
     Parameters
     ----------
@@ -186,37 +220,47 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     clip_of_problem, graph_of_problem : ndarray of shape (n_problems,)
         Each problem decodes one clip under one graph.
     layer : int
-        The layer to stop at (the root is layer 0).
+        The layer to stop at (the root is layer 0); the deepest scored layer.
     n_paths : int, default=5
-        Nodes kept per frame at each layer, and sequences returned.
+        Nodes kept per frame at each layer, and sequences returned per scored layer.
+    score_layers : int, default=1
+        How many layers, ending at ``layer``, are scored (at most ``layer``:
+        layers ``max(1, layer - score_layers + 1) .. layer``).
     node_prior : {"graph", "layer"}, default="graph"
     guide : TransitionGraphs, default=None
-        When given (one graph, e.g. the global graph), the layers above
-        ``layer`` are searched once per clip under it, and every problem's
-        graph only runs the last K-best pass on the candidates this shared
-        beam leaves: much faster with many graphs, and the same with a wide
-        beam. By default each problem searches under its own graph.
+        When given (one graph, e.g. the global graph), the beams are searched
+        once per clip under it, and every problem's graph only runs the K-best
+        passes on the candidates this shared beam leaves: much faster with many
+        graphs, and the same with a wide beam. By default each problem searches
+        under its own graph.
     normalise : bool, default=True
         Score with ``log Ps``; without, with ``log Po`` (rankings within a
         problem are the same; across the graphs of a clip too when the
         normaliser is shared, ``node_prior="layer"``).
     prune : bool, default=False
-        Classification only: run the K-best pass only on the problems that may
-        hold the highest summed score of their clip. The sum of ``n_paths``
-        sequences lies between the best one and ``n_paths`` times it, so a
-        problem whose best sequence scores more than ``log(n_paths)`` below
-        the best sequence of another problem of the same clip can never win;
-        it gets ``-inf`` scores and -1 paths. A clip left with one problem
-        has its winner: that problem gets only its best sequence's score (the
-        others ``-inf``) and -1 paths. Which problem wins is unchanged.
+        Classification only, with a ``guide``: run the K-best passes only on the
+        problems that may hold the highest summed score of their clip (the
+        clip's problems share its search, so this is decided per search, with
+        nothing recomputed). At each scored layer the
+        sum of ``n_paths`` sequences lies between the best one and ``n_paths``
+        times it, so a problem whose best sequences (summed over the scored
+        layers) score more than ``n_scored log(n_paths)`` below those of another
+        problem of the same clip can never win; it gets ``-inf`` scores and -1
+        paths. A clip left with one problem has its winner: that problem gets
+        only its best sequences' scores (the others ``-inf``) and -1 paths.
+        Which problem wins is unchanged.
+    return_paths : bool, default=True
+        Whether to return the node sequences (scores only are cheaper).
 
     Returns
     -------
-    paths : ndarray of shape (n_problems, n_paths, max_frames)
+    paths : ndarray of shape (n_problems, n_paths, max_frames) or None
         Node sequences (layer indices) at ``layer``, best first; a problem's
-        sequences end at its clip's length (-1 after it); -1 rows for missing ones.
-    scores : ndarray of shape (n_problems, n_paths)
-        Their log probabilities ``log P(N | X)`` (``-inf`` for missing sequences).
+        sequences end at its clip's length (-1 after it); -1 rows for missing
+        ones. None without ``return_paths``.
+    scores : ndarray of shape (n_problems, n_scored, n_paths)
+        Log probabilities ``log P(N | X)`` of the ``n_paths`` best sequences
+        at each scored layer, shallowest first (``-inf`` for missing ones).
 
     Examples
     --------
@@ -227,10 +271,14 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     >>> graphs = TransitionGraphs.count(tree.iter_apply(frames), tree.n_nodes, offsets=[0, 40],
     ...                                 graph_of_clip=[0])
     >>> paths, scores = beam_decode(tree, graphs, frames[18:22], [0, 4], [0], [0], layer=1, n_paths=1)
-    >>> paths[0].tolist()
-    [[0, 0, 1, 1]]
+    >>> paths[0].tolist(), scores.shape
+    ([[0, 0, 1, 1]], (1, 1, 1))
     """
     layer = tree.check_layer(layer)
+    if not isinstance(score_layers, Integral) or isinstance(score_layers, bool) or score_layers < 1:
+        raise ValueError(f"score_layers must be an int >= 1; got {score_layers!r}.")
+    if prune and guide is None:
+        raise ValueError("prune needs a guide: the problems of a clip are compared within the clip's shared search.")
     offsets = np.asarray(offsets, dtype=np.intp)
     clip_of_problem = np.asarray(clip_of_problem, dtype=np.intp)
     graph_of_problem = np.asarray(graph_of_problem, dtype=np.intp)
@@ -238,46 +286,38 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     n_problems = len(clip_of_problem)
     lengths = np.diff(offsets)
     n_steps = int(lengths[clip_of_problem].max()) if n_problems else 0
-    if layer == 0:
+    if layer == 0:  # every frame at the root, with probability 1
         paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
-        paths[:, 0] = 0
-        scores = np.full((n_problems, n_paths), -np.inf)
-        scores[:, 0] = 0.0
-        return paths, scores
-    if guide is None:  # every problem searches the upper layers under its own graph
-        beam, beam_start = _descend(tree, graphs, frames, offsets[clip_of_problem], lengths[clip_of_problem],
-                                    graph_of_problem, layer=layer - 1, n_paths=n_paths, node_prior=node_prior)
+        paths[:, 0] = np.where(np.arange(n_steps) < lengths[clip_of_problem][:, None], 0, -1)
+        scores = np.full((n_problems, 1, n_paths), -np.inf)
+        scores[:, :, 0] = 0.0
+        return (paths if return_paths else None), scores
+    first = max(1, layer - int(score_layers) + 1)
+    if guide is None:  # every problem searches under its own graph
+        order = None
+        search_clip, search_graph, search = clip_of_problem, graph_of_problem, graphs
+        problem_start = np.arange(n_problems + 1, dtype=np.intp)
+        score_graph = graph_of_problem
     else:  # one search per clip under the guide, shared by the clip's problems
+        order = np.argsort(clip_of_problem, kind="stable")
+        search_clip, per_clip = np.unique(clip_of_problem, return_counts=True)
+        search_graph, search = np.zeros(len(search_clip), dtype=np.intp), guide
+        problem_start = np.concatenate([[0], np.cumsum(per_clip)]).astype(np.intp)
+        score_graph = np.ascontiguousarray(graph_of_problem[order])
+    specs = _layer_specs(tree, search, graphs, layer, node_prior, mask_scored=guide is not None)
+    mode = "prune" if prune and n_paths > 1 else "kbest"
+    scores, paths, _ = decode_searches(
+        frames, offsets[search_clip], lengths[search_clip], search_graph, problem_start, score_graph,
+        tree.kernel_gaussians(), specs, first, n_paths, mode, return_paths,
+    )
+    if order is not None:
+        back = np.empty_like(order)
+        back[order] = np.arange(n_problems)
+        scores = scores[back]
+        paths = paths[back] if return_paths else None
+    if normalise and n_problems:
         clips, inverse = np.unique(clip_of_problem, return_inverse=True)
-        beam, clip_rows = _descend(tree, guide, frames, offsets[clips], lengths[clips],
-                                   np.zeros(len(clips), dtype=np.intp), layer=layer - 1, n_paths=n_paths,
-                                   node_prior=node_prior)
-        beam_start = clip_rows[inverse]
-    allowed = _allowed_nodes(graphs, layer, node_prior)
-    norm, norm_col = np.zeros((0, 0)), np.zeros(n_problems, dtype=np.intp)
-    if normalise:
-        norm = np.ascontiguousarray(_log_normaliser(tree.log_likelihood(frames, layer), allowed))
-        if allowed.shape[0] > 1:
-            norm_col = graph_of_problem
-    args = (frames, offsets[clip_of_problem], lengths[clip_of_problem], beam, beam_start, graph_of_problem,
-            _children(tree, layer - 1), _kernel_allowed(graphs, layer, node_prior), tree.kernel_gaussians(),
-            tree.node_ids(layer), graphs.kernel_table(layer), norm, norm_col, n_paths)
-    if not (prune and n_paths > 1):
-        return kbest_layer(*args, False)
-    # The sum of n_paths sequences lies between the best one and n_paths times it.
-    _, best = kbest_layer(*args, True)
-    best = best[:, 0]
-    clips, inverse = np.unique(clip_of_problem, return_inverse=True)
-    top = np.full(len(clips), -np.inf)
-    np.maximum.at(top, inverse, best)
-    # Kept with a margin for rounding in the sums of n_paths terms.
-    live = best + np.log(n_paths) >= top[inverse] - 1e-9 * np.abs(top[inverse])
-    paths = np.full((n_problems, n_paths, n_steps), -1, dtype=np.intp)
-    scores = np.full((n_problems, n_paths), -np.inf)
-    alone = live & (np.bincount(inverse, weights=live)[inverse] == 1)
-    scores[alone, 0] = best[alone]
-    live = np.flatnonzero(live & ~alone)
-    live_args = [a[live] if i in (1, 2, 4, 5, 12) else a for i, a in enumerate(args)]
-    live_paths, scores[live] = kbest_layer(*live_args, False)
-    paths[live, :, : live_paths.shape[2]] = live_paths
+        sums = _clip_normalisers(tree, graphs, frames, offsets, clips, range(first, layer + 1), node_prior)
+        column = graph_of_problem if sums.shape[2] > 1 else np.zeros(n_problems, dtype=np.intp)
+        scores -= sums[:, inverse, column].T[:, :, None]
     return paths, scores

@@ -80,6 +80,16 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     layer : int, default=None
         The layer to classify at (negative counts from the bottom); None for
         the bottom layer. Upper layers are faster and coarser.
+    score_layers : int or "all", default=1
+        How many layers, ending at ``layer``, classify together: a clip's score
+        under a graph is the product of its generation probabilities at each
+        of them (a product of experts over the tree's resolutions; the paper
+        classifies at one layer). Coarse layers are robust and fine ones
+        precise; together they vary less with the tree's depth. At most layers
+        1 to ``layer`` are used (``"all"``: every one of them), so a grid over
+        ``max_depth`` can share one value. The scored layers are searched on
+        the way down anyway: each one adds a pass over its candidates per
+        graph, not another search.
     standardize : bool, default=True
         Scale every channel to zero mean and unit variance (statistics of the
         training frames; a constant channel is only centred) before building
@@ -106,6 +116,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         The class labels.
     layer_ : int
         The (non-negative) layer used for classification.
+    score_layers_ : ndarray of int
+        The layers whose generation probabilities are multiplied to classify
+        (``[0]`` for a tree of one layer).
     center_, scale_ : ndarray of shape (n_features_in_,)
         The standardisation (zeros and ones when ``standardize=False``).
     n_layers_ : int
@@ -167,6 +180,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         "smoothing": [Interval(Real, 0, None, closed="neither")],
         "n_paths": [Interval(Integral, 1, None, closed="left")],
         "layer": [Interval(Integral, None, None, closed="neither"), None],
+        "score_layers": [Interval(Integral, 1, None, closed="left"), StrOptions({"all"})],
         "standardize": ["boolean"],
         "n_jobs": [Integral, None],
     }
@@ -185,6 +199,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         smoothing=1.0,
         n_paths=3,
         layer=None,
+        score_layers=1,
         standardize=True,
         n_jobs=None,
     ):
@@ -199,6 +214,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.smoothing = smoothing
         self.n_paths = n_paths
         self.layer = layer
+        self.score_layers = score_layers
         self.standardize = standardize
         self.n_jobs = n_jobs
 
@@ -242,6 +258,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             reg_covar=self.reg_covar,
         )
         self.layer_ = tree.check_layer(-1 if self.layer is None else self.layer)
+        n_scored = self.layer_ if self.score_layers == "all" else min(self.score_layers, self.layer_)
+        self.score_layers_ = np.arange(self.layer_ - n_scored + 1, self.layer_ + 1) if self.layer_ else np.zeros(1, int)
         labels = list(tree.iter_apply(frames))
         n_clips = len(clips)
         self.global_graph_ = TransitionGraphs.count(
@@ -263,8 +281,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     # -- decoding ------------------------------------------------------------------
 
-    def _decode(self, clips, graphs, layer, n_graphs, exact=True, prune=False):
-        """Beam-decode every clip under every graph: paths and scores per clip.
+    def _decode(self, clips, graphs, layer, n_graphs, *, score_layers=1, exact=True, prune=False, paths=True):
+        """Beam-decode every clip under every graph: paths and scores per clip (see ``decode_clips``).
 
         Without ``exact``, and when the normaliser of ``Ps`` is the same for
         every graph (``node_prior="layer"``), scores skip it: rankings are equal.
@@ -273,22 +291,26 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         normalise = exact or self.node_prior != "layer"
         # One beam search per clip on the global graph, shared by all graphs. Under
         # node_prior="graph" a graph may have no candidate left in the shared beam,
-        # so each graph then searches on its own.
+        # so each graph then searches on its own (and nothing is pruned: pruning
+        # compares the graphs of a clip within its shared search).
         guide = self.global_graph_ if self.node_prior == "layer" else None
         frames, offsets = stack_clips(clips)
         return decode_clips(
             self.tree_, graphs, (frames - self.center_) / self.scale_, offsets, n_graphs=n_graphs, layer=layer,
-            n_paths=self.n_paths, node_prior=self.node_prior, guide=guide, normalise=normalise, prune=prune, n_jobs=self.n_jobs,
+            n_paths=self.n_paths, node_prior=self.node_prior, score_layers=score_layers, guide=guide,
+            normalise=normalise, prune=prune and guide is not None, return_paths=paths, n_jobs=self.n_jobs,
         )
 
     def _class_log_probs(self, clips, exact=True, prune=False):
         """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
 
-        Without ``exact``, up to a constant per clip (enough to rank classes).
-        With ``prune``, ``-inf`` for classes that provably do not score best.
+        The product over the scored layers. Without ``exact``, up to a constant
+        per clip (enough to rank classes). With ``prune``, ``-inf`` for classes
+        that provably do not score best.
         """
-        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_), exact, prune)
-        per_graph = logsumexp(scores, axis=2)
+        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_),
+                                 score_layers=len(self.score_layers_), exact=exact, prune=prune, paths=False)
+        per_graph = logsumexp(scores, axis=3).sum(axis=2)
         if self.graph == "class":
             return per_graph
         out = np.full((len(clips), len(self.classes_)), -np.inf)
@@ -308,7 +330,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         -------
         log_prob : ndarray of shape (n_clips, n_classes)
             ``log`` of the summed probability of the ``n_paths`` best node
-            sequences at ``layer_``; columns follow ``classes_``.
+            sequences at ``layer_`` (summed over ``score_layers_`` when there
+            are several); columns follow ``classes_``.
         """
         check_is_fitted(self)
         return self._class_log_probs(check_clips(X, estimator=self))
@@ -428,7 +451,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         layer = self._resolve_layer(layer)
         k = self.tree_.n_nodes[layer]
         paths, scores = self._decode(clips, self.global_graph_, layer, 1, exact=False)
-        weights = np.exp(scores[:, 0] - logsumexp(scores[:, 0], axis=1, keepdims=True))
+        scores = scores[:, 0, -1]  # the one graph, at the one layer
+        weights = np.exp(scores - logsumexp(scores, axis=1, keepdims=True))
         current = np.zeros((len(clips), k))
         for i, p in enumerate(paths):
             valid = p[0, :, -1] >= 0

@@ -94,6 +94,7 @@ class MotionTree:
         self.reg = reg
         self.principal_axes = principal_axes
         self._gaussians = Gaussians(mean, covariance, covariance_type)
+        self._kernel_children = [np.ascontiguousarray(self.children(layer)) for layer in range(len(layers))]
 
     @classmethod
     def build(cls, frames, *, max_depth=None, min_samples_split=2, min_samples_leaf=16, split="min_error",
@@ -307,6 +308,10 @@ class MotionTree:
     def kernel_gaussians(self):
         """The nodes' Gaussians as the compiled decoder reads them (see ``Gaussians.kernel_arrays``)."""
         return self._gaussians.kernel_arrays()
+
+    def kernel_children(self, layer):
+        """``children(layer)`` as the compiled decoder reads it: made once, C-contiguous."""
+        return self._kernel_children[self.check_layer(layer)]
 
     def _check_frames(self, frames):
         X = np.asarray(frames, dtype=np.float64)

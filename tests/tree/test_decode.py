@@ -62,7 +62,7 @@ def test_a_wide_beam_agrees_with_the_exhaustive_viterbi(model, prior, guided):
                                         n_paths=wide, node_prior=prior, guide=guide)
             ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
                                                      node_prior=prior)
-            np.testing.assert_allclose(scores[0], ex_scores)
+            np.testing.assert_allclose(scores[0, 0], ex_scores)
             finite = np.isfinite(ex_scores)
             np.testing.assert_array_equal(paths[0][finite], ex_paths[finite])
 
@@ -86,7 +86,7 @@ def test_the_compiled_decoder_agrees_for_every_covariance_and_table(monkeypatch,
     for graph in (0, 1):
         paths, scores = beam_decode(tree, graphs, clip, [0, 5], [0], [graph], layer=-1, n_paths=wide, node_prior="layer")
         ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, -1, clip, graph, n_paths=wide, node_prior="layer")
-        np.testing.assert_allclose(scores[0], ex_scores, rtol=1e-12)
+        np.testing.assert_allclose(scores[0, 0], ex_scores, rtol=1e-12)
         np.testing.assert_array_equal(paths[0], ex_paths)
 
 
@@ -125,7 +125,7 @@ def test_the_compiled_beams_follow_their_definition(model, n_paths):
     clip = frames[rng.integers(0, 100, size=12)] + rng.normal(scale=0.5, size=(12, 2))
     for graph in (0, 1):
         for layer in range(1, tree.n_layers):
-            beam, _ = _descend(tree, graphs, clip, np.array([0]), np.array([12]), np.array([graph]), layer=layer,
+            beam = _descend(tree, graphs, clip, np.array([0]), np.array([12]), np.array([graph]), layer=layer,
                                n_paths=n_paths, node_prior="layer")
             np.testing.assert_array_equal(beam, reference_beams(tree, graphs, clip, graph, n_paths, layer))
 
@@ -138,12 +138,12 @@ def test_a_narrow_beam_never_beats_the_exhaustive_search(model, n_paths):
         clip = frames[rng.integers(0, 100, size=8)]
         _, scores = beam_decode(tree, graphs, clip, [0, 8], [0], [1], layer=-1, n_paths=n_paths)
         _, best = exhaustive_viterbi(tree, graphs, -1, clip, 1, n_paths=n_paths)
-        assert (scores[0] <= best + 1e-9).all()
+        assert (scores[0, 0] <= best + 1e-9).all()
         # the scores are those of the returned sequences
         paths, _ = beam_decode(tree, graphs, clip, [0, 8], [0], [1], layer=-1, n_paths=n_paths)
         log_ps = node_log_posterior(tree, graphs, -1, clip, "graph")[1]
         log_pt = np.log(graphs.matrix(tree.n_layers - 1, 1))
-        for seq, score in zip(paths[0], scores[0]):
+        for seq, score in zip(paths[0], scores[0, 0]):
             if np.isfinite(score):
                 own = log_ps[np.arange(8), seq].sum() + log_pt[seq[:-1], seq[1:]].sum()
                 assert own == pytest.approx(score)
@@ -177,7 +177,7 @@ def test_clips_of_different_lengths_decode_as_if_alone(model, guided):
 def test_layer_zero_is_the_root_with_probability_one(model):
     tree, graphs, frames = model
     paths, scores = beam_decode(tree, graphs, frames[:5], [0, 5], [0], [0], layer=0, n_paths=2)
-    assert scores[0].tolist() == [0.0, -np.inf]
+    assert scores[0].tolist() == [[0.0, -np.inf]]
     assert paths[0, 0].tolist() == [0] * 5 and (paths[0, 1] == -1).all()
 
 
@@ -185,7 +185,7 @@ def test_ten_thousand_frames_keep_finite_probabilities(model):
     tree, graphs, frames = model
     clip = frames[np.arange(10_000) % 100]
     paths, scores = beam_decode(tree, graphs, clip, [0, 10_000], [0], [0], layer=-1, n_paths=2)
-    assert np.isfinite(scores).all() and scores[0, 0] < -1000  # far below the smallest double
+    assert np.isfinite(scores).all() and scores[0, 0, 0] < -1000  # far below the smallest double
     assert (paths[0] >= 0).all()
 
 
@@ -199,7 +199,7 @@ def test_the_normaliser_survives_underflow():
     assert np.isfinite(_log_normaliser(log_po, allowed)).all()
 
 
-def pruning_case(seed, guided):
+def pruning_case(seed, score_layers):
     """Check prune=True against prune=False; say whether clips with one and with several survivors occurred."""
     rng = np.random.default_rng(seed)
     n_clips = 8
@@ -211,22 +211,22 @@ def pruning_case(seed, guided):
     graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
                                     graph_of_clip=np.arange(n_clips), smoothing=0.5)
     guide = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
-                                   graph_of_clip=np.zeros(n_clips, dtype=int)) if guided else None
+                                   graph_of_clip=np.zeros(n_clips, dtype=int))
     queries = frames + rng.normal(scale=0.5, size=frames.shape)  # every clip under every clip's graph
     clip_of_problem, graph_of_problem = np.repeat(np.arange(n_clips), n_clips), np.tile(np.arange(n_clips), n_clips)
     args = (tree, graphs, queries, offsets, clip_of_problem, graph_of_problem)
-    kwargs = dict(layer=-1, n_paths=3, node_prior="layer", guide=guide, normalise=False)
+    kwargs = dict(layer=-1, n_paths=3, node_prior="layer", guide=guide, normalise=False, score_layers=score_layers)
     full_paths, full = beam_decode(*args, **kwargs)
     paths, pruned = beam_decode(*args, **kwargs, prune=True)
-    total, total_full = logsumexp(pruned, axis=1), logsumexp(full, axis=1)
+    total, total_full = logsumexp(pruned, axis=2).sum(axis=1), logsumexp(full, axis=2).sum(axis=1)
     live = np.isfinite(total)
     alone = live & (np.bincount(clip_of_problem, weights=live)[clip_of_problem] == 1)
     np.testing.assert_array_equal(pruned[live & ~alone], full[live & ~alone])
     np.testing.assert_array_equal(paths[live & ~alone], full_paths[live & ~alone])
-    # a clip's only survivor keeps its best sequence's score alone
-    np.testing.assert_array_equal(pruned[alone, 0], full[alone, 0])
-    assert np.isneginf(pruned[alone, 1:]).all() and (paths[alone] == -1).all()
-    assert (paths[~live] == -1).all()
+    # a clip's only survivor keeps its best sequences' scores alone
+    np.testing.assert_array_equal(pruned[alone, :, 0], full[alone, :, 0])
+    assert np.isneginf(pruned[alone, :, 1:]).all() and (paths[alone] == -1).all()
+    assert (paths[~live] == -1).all() and np.isneginf(pruned[~live]).all()
     for c in range(n_clips):
         rows = clip_of_problem == c
         assert np.argmax(total[rows]) == np.argmax(total_full[rows])
@@ -235,8 +235,77 @@ def pruning_case(seed, guided):
     return alone.any(), (live & ~alone).any()
 
 
-@pytest.mark.parametrize("guided", [False, True])
-def test_pruning_keeps_the_winner_of_every_clip(guided):
-    """Problems left out of the K-best pass provably could not have the highest summed score."""
-    kinds = np.array([pruning_case(seed, guided) for seed in range(10)])
+@pytest.mark.parametrize("score_layers", [1, 3])
+def test_pruning_keeps_the_winner_of_every_clip(score_layers):
+    """Problems left out of the K-best passes provably could not have the highest summed score."""
+    kinds = np.array([pruning_case(seed, score_layers) for seed in range(10)])
     assert kinds.any(axis=0).all()  # clips with one survivor and clips with several both occurred
+
+
+def test_pruning_needs_a_guide(model):
+    tree, graphs, frames = model
+    with pytest.raises(ValueError, match="prune needs a guide"):
+        beam_decode(tree, graphs, frames[:5], [0, 5], [0], [0], layer=-1, n_paths=2, prune=True)
+
+
+@pytest.fixture(scope="module")
+def copied_model():
+    """A minimum-error tree whose small clusters stop early: leaves copied down into lower layers."""
+    rng = np.random.default_rng(7)
+    frames = np.vstack([rng.normal(c, s, size=(n, 2)) for c, s, n in [(0, 0.3, 60), (5, 1.0, 12), (9, 0.5, 24)]])
+    offsets = np.array([0, 40, 70, 96])
+    tree = MotionTree.build(frames, max_depth=4, min_samples_leaf=6, split="min_error")
+    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
+                                    graph_of_clip=[0, 1, 1], smoothing=0.5)
+    guide = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
+                                   graph_of_clip=[0, 0, 0])
+    copies = [bool(np.isin(tree.layers[l], tree.layers[l - 1]).any()) for l in range(2, tree.n_layers)]
+    assert any(copies)  # the case this fixture exists for
+    return tree, graphs, guide, frames
+
+
+@pytest.mark.parametrize("prior", ["graph", "layer"])
+@pytest.mark.parametrize("guided", [False, True])
+def test_every_scored_layer_agrees_with_the_exhaustive_viterbi(copied_model, prior, guided):
+    """A wide beam scoring all layers at once gives each layer's exhaustive K-best list (copied leaves too)."""
+    tree, graphs, guide, frames = copied_model
+    clip = frames[[3, 61, 80, 90, 10, 65, 30]] + 0.1
+    wide = int(tree.n_nodes.max())
+    for graph in (0, 1):
+        paths, scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [graph], layer=-1, n_paths=wide,
+                                    score_layers=tree.n_layers, node_prior=prior, guide=guide if guided else None)
+        assert scores.shape == (1, tree.n_layers - 1, wide)
+        for row, layer in enumerate(range(1, tree.n_layers)):
+            ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
+                                                     node_prior=prior)
+            # the normaliser is subtracted as a per-clip sum: rounding is absolute, at the terms' scale
+            np.testing.assert_allclose(scores[0, row], ex_scores, rtol=1e-12, atol=1e-9)
+        finite = np.isfinite(ex_scores)
+        np.testing.assert_array_equal(paths[0][finite], ex_paths[finite])
+
+
+@pytest.mark.parametrize("n_paths", [1, 2, 3])
+def test_scoring_several_layers_equals_scoring_each_alone(copied_model, n_paths):
+    """Beams above a layer do not depend on which layers are scored: each row is that layer's own decode."""
+    tree, graphs, guide, frames = copied_model
+    rng = np.random.default_rng(n_paths)
+    clips = [frames[rng.integers(0, 96, size=n)] + rng.normal(scale=0.4, size=(n, 2)) for n in (9, 1, 14)]
+    stacked, offsets = np.vstack(clips), np.array([0, 9, 10, 24])
+    problems = dict(clip_of_problem=[0, 0, 1, 1, 2, 2], graph_of_problem=[0, 1, 0, 1, 0, 1])
+    for kwargs in (dict(guide=guide, node_prior="layer"), dict(node_prior="graph")):
+        paths, scores = beam_decode(tree, graphs, stacked, offsets, *problems.values(), layer=-1, n_paths=n_paths,
+                                    score_layers=3, **kwargs)
+        bottom = tree.n_layers - 1
+        for row, layer in enumerate(range(bottom - 2, bottom + 1)):
+            alone_paths, alone = beam_decode(tree, graphs, stacked, offsets, *problems.values(), layer=layer,
+                                             n_paths=n_paths, **kwargs)
+            np.testing.assert_allclose(scores[:, row], alone[:, 0], rtol=1e-12, atol=1e-9)
+        np.testing.assert_array_equal(paths, alone_paths)
+
+
+def test_score_layers_stop_at_layer_one(model):
+    tree, graphs, frames = model
+    _, scores = beam_decode(tree, graphs, frames[:6], [0, 6], [0], [0], layer=2, n_paths=2, score_layers=10)
+    assert scores.shape == (1, 2, 2)  # layers 1 and 2
+    with pytest.raises(ValueError, match="score_layers must be an int >= 1"):
+        beam_decode(tree, graphs, frames[:6], [0, 6], [0], [0], layer=2, score_layers=0)

@@ -222,3 +222,35 @@ def test_pruned_predict_agrees_with_full_scoring(motions, graph):
     X, y, _ = motions
     model = MotionTreeHMM(max_depth=4, n_paths=3, graph=graph).fit(X[::2], y[::2])
     np.testing.assert_array_equal(model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)])
+
+
+def test_several_scored_layers_multiply_their_generation_probabilities(motions):
+    """score_samples over three layers is the sum of the single-layer models' log probabilities."""
+    X, y, _ = motions
+    model = MotionTreeHMM(max_depth=5, split="median", score_layers=3).fit(X[::2], y[::2])
+    np.testing.assert_array_equal(model.score_layers_, [3, 4, 5])
+    per_layer = [MotionTreeHMM(max_depth=5, split="median", layer=layer).fit(X[::2], y[::2]) for layer in (3, 4, 5)]
+    expected = np.sum([m.score_samples(X[1::3]) for m in per_layer], axis=0)
+    np.testing.assert_allclose(model.score_samples(X[1::3]), expected, rtol=1e-10)
+    log_prob = model.score_samples(X[:5])
+    np.testing.assert_allclose(model.predict_proba(X[:5]), np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True)))
+
+
+@pytest.mark.parametrize("graph", ["class", "clip"])
+def test_pruned_predict_over_several_layers_agrees_with_full_scoring(motions, graph):
+    # with clip graphs a class scores as its best clip's product over the layers
+    X, y, _ = motions
+    model = MotionTreeHMM(max_depth=5, n_paths=3, score_layers=3, graph=graph).fit(X[::2], y[::2])
+    np.testing.assert_array_equal(model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)])
+
+
+def test_score_layers_all_and_beyond_the_tree(motions):
+    X, y, _ = motions
+    everything = MotionTreeHMM(max_depth=4, score_layers="all").fit(X[::3], y[::3])
+    np.testing.assert_array_equal(everything.score_layers_, [1, 2, 3, 4])
+    beyond = MotionTreeHMM(max_depth=4, score_layers=50).fit(X[::3], y[::3])
+    np.testing.assert_array_equal(beyond.score_samples(X[1::5]), everything.score_samples(X[1::5]))
+    upper = MotionTreeHMM(max_depth=4, layer=2, score_layers=2).fit(X[::3], y[::3])
+    np.testing.assert_array_equal(upper.score_layers_, [1, 2])
+    with pytest.raises(ValueError, match="score_layers"):
+        MotionTreeHMM(score_layers=0).fit(X, y)
