@@ -28,14 +28,16 @@ subtracts its per-clip sum from the scores.
 
 import numpy as np
 
-from libc.math cimport INFINITY, log
+from libc.math cimport INFINITY, NAN, log
 from libc.stdlib cimport free, malloc
 
 ctypedef Py_ssize_t intp
 
 cdef extern from "_emission.h" nogil:
-    double skm_diag_maha(const double* x, const double* mu, const double* prec, Py_ssize_t d)
-    double skm_full_maha(const double* x, const double* factor, const double* shift, Py_ssize_t d, double* y)
+    void skm_diag_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* prec, double c,
+                      double* out, Py_ssize_t stride)
+    void skm_full_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* factor, const double* shift,
+                      double c, double* out, Py_ssize_t stride, double* y)
 
 #: What a call computes per problem; see :func:`decode_searches`.
 MODES = ("beam", "best", "kbest", "prune")
@@ -76,11 +78,16 @@ cdef struct Layer:
     intp k
 
 
-cdef inline double _emission(const Gaussians* g, const double* x, intp n, double* y) noexcept nogil:
-    """Log density of frame ``x`` under tree node ``n``'s Gaussian; ``y`` is scratch of ``d`` doubles."""
+cdef inline void _emissions(const Gaussians* g, const double* x, intp n, intp node, double* out, intp stride,
+                            double* y) noexcept nogil:
+    """Log densities of ``n`` consecutive frames from ``x`` under tree node ``node``'s Gaussian.
+
+    Written to ``out[i * stride]``; ``y`` is scratch of ``4 d`` doubles.
+    """
     if g.full:
-        return g.const_[n] - 0.5 * skm_full_maha(x, g.prec + n * g.d * g.d, g.shifts + n * g.d, g.d, y)
-    return g.const_[n] - 0.5 * skm_diag_maha(x, g.means + n * g.d, g.prec + n * g.d, g.d)
+        skm_full_run(x, n, g.d, g.prec + node * g.d * g.d, g.shifts + node * g.d, g.const_[node], out, stride, y)
+    else:
+        skm_diag_run(x, n, g.d, g.means + node * g.d, g.prec + node * g.d, g.const_[node], out, stride)
 
 
 cdef inline double _transition(const Table* t, intp graph, intp src, intp dst) noexcept nogil:
@@ -344,7 +351,7 @@ cdef struct Work:
     double* scratch
     intp* head
     intp* back          # (T, n_paths, 2 n_paths), or NULL when no paths are wanted
-    double* y           # (d,)
+    double* y           # (4 d,)
 
 
 cdef void _free_work(Work* w) noexcept:
@@ -370,41 +377,57 @@ cdef bint _alloc_work(Work* w, intp max_steps, intp n_paths, intp slots, intp d,
     w.scratch = <double*> malloc(n_paths * nc * sizeof(double))
     w.head = <intp*> malloc(nc * sizeof(intp))
     w.back = <intp*> malloc(t * n_paths * nc * sizeof(intp)) if paths else NULL
-    w.y = <double*> malloc(max(d, 1) * sizeof(double))
+    w.y = <double*> malloc(4 * max(d, 1) * sizeof(double))
     return not (w.beam == NULL or w.next_beam == NULL or w.beam_emit == NULL or w.next_emit == NULL
                 or w.cand == NULL or w.emit == NULL or w.masked == NULL or w.steps == NULL or w.fwd == NULL
                 or w.bwd == NULL or w.moves == NULL or w.delta == NULL or w.scratch == NULL or w.head == NULL
                 or (paths and w.back == NULL) or w.y == NULL)
 
 
-cdef intp _candidates(const Layer* lay, intp n_steps, intp width, intp search_graph,
-                      bint carry, const Gaussians* g, const double* frames, Work* w, intp* cand, double* emit,
+cdef intp _candidates(const Layer* lay, intp n_steps, intp width, intp search_graph, bint carry,
+                      const Gaussians* g, const double* frames, Work* w, intp* cand, double* emit,
                       bint emissions) noexcept nogil:
     """Each frame's candidates (children of its kept nodes) and, with ``emissions``, their log densities.
 
     A leaf copied down is its own only child: with ``carry`` (the kept nodes'
-    emissions are known) its emission is carried, not recomputed. Returns the
+    emissions are known) its emission is carried, not recomputed. The others
+    are computed per run of frames whose slot holds the same node. Returns the
     candidates per frame.
     """
-    cdef intp t, side, j, node, child, n_cand = 2 * width
+    cdef intp t, side, j, c, node, child, end, n_cand = 2 * width
     cdef const unsigned char* allowed = (lay.search_allowed + search_graph * lay.k
                                          if lay.search_allowed != NULL else NULL)
     for t in range(n_steps):
         for side in range(2):
             for j in range(width):
+                c = t * n_cand + side * width + j
                 node = w.beam[t * width + j]
                 child = -1 if node < 0 else lay.children[2 * node + side]
                 if child >= 0 and allowed != NULL and not allowed[child]:
                     child = -1
-                cand[t * n_cand + side * width + j] = child
+                cand[c] = child
                 if not emissions:
                     continue
                 if child < 0:
-                    emit[t * n_cand + side * width + j] = -INFINITY
+                    emit[c] = -INFINITY
                 elif carry and side == 0 and lay.children[2 * node + 1] < 0:
-                    emit[t * n_cand + j] = w.beam_emit[t * width + j]
+                    emit[c] = w.beam_emit[t * width + j]
                 else:
-                    emit[t * n_cand + side * width + j] = _emission(g, frames + t * g.d, lay.ids[child], w.y)
+                    emit[c] = NAN  # to compute, below
+    if not emissions:
+        return n_cand
+    for c in range(n_cand):
+        t = 0
+        while t < n_steps:
+            if emit[t * n_cand + c] == emit[t * n_cand + c]:  # known (not NaN)
+                t += 1
+                continue
+            child = cand[t * n_cand + c]
+            end = t + 1
+            while end < n_steps and cand[end * n_cand + c] == child and emit[end * n_cand + c] != emit[end * n_cand + c]:
+                end += 1
+            _emissions(g, frames + t * g.d, end - t, lay.ids[child], emit + t * n_cand + c, n_cand, w.y)
+            t = end
     return n_cand
 
 
@@ -412,12 +435,17 @@ cdef intp _keep(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const
                 const Table* tab, intp graph, Work* w) noexcept nogil:
     """The next layer's beam (``w.next_beam``, ``w.next_emit``): each frame's ``n_paths`` best candidates.
 
-    Best max-marginal first, ties to the lower slot, -1 for candidates of no
-    finite score; with ``n_cand <= n_paths`` all are kept, unscored (and their
-    emissions carried when ``have_emit``). Returns the new width.
+    The best max-marginals are kept (ties to the lower slot), -1 for candidates
+    of no finite score; with ``n_cand <= n_paths`` all are kept, unscored (and
+    their emissions carried when ``have_emit``). A frame's kept nodes are stored
+    in node order, -1 last: consecutive frames often keep the same nodes, whose
+    slots then match, so their moves are looked up once and a slot's emissions
+    run over many frames. Returns the new width.
     """
-    cdef intp t, c, r, keep
-    cdef double v
+    cdef intp t, c, r, i, keep, node
+    cdef double v, e
+    cdef intp* kept
+    cdef double* kept_emit
     if n_cand <= n_paths:
         for t in range(n_steps * n_cand):
             w.next_beam[t] = cand[t]
@@ -428,12 +456,21 @@ cdef intp _keep(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const
     _steps(n_steps, n_cand, tab, graph, cand, emit, w.moves, w.steps)
     _max_marginals(n_steps, n_cand, emit, w.steps, w.fwd, w.bwd)
     for t in range(n_steps):
+        kept = w.next_beam + t * keep
+        kept_emit = w.next_emit + t * keep
         for c in range(n_cand):
             w.fwd[t * n_cand + c] += w.bwd[t * n_cand + c]
         for r in range(keep):
             c = _pick(w.fwd + t * n_cand, n_cand, &v)
-            w.next_beam[t * keep + r] = cand[t * n_cand + c] if v > -INFINITY else -1
-            w.next_emit[t * keep + r] = emit[t * n_cand + c]
+            node = cand[t * n_cand + c] if v > -INFINITY else -1
+            e = emit[t * n_cand + c]
+            i = r  # insertion into node order, -1 last
+            while i > 0 and (kept[i - 1] < 0 or (0 <= node < kept[i - 1])):
+                kept[i] = kept[i - 1]
+                kept_emit[i] = kept_emit[i - 1]
+                i -= 1
+            kept[i] = node
+            kept_emit[i] = e
     return keep
 
 

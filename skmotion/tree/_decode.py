@@ -305,7 +305,8 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         problem_start = np.concatenate([[0], np.cumsum(per_clip)]).astype(np.intp)
         score_graph = np.ascontiguousarray(graph_of_problem[order])
     specs = _layer_specs(tree, search, graphs, layer, node_prior, mask_scored=guide is not None)
-    mode = "prune" if prune and n_paths > 1 else "kbest"
+    # One sequence and no paths: the forward pass alone gives its score.
+    mode = "best" if n_paths == 1 and not return_paths else "prune" if prune and n_paths > 1 else "kbest"
     scores, paths, _ = decode_searches(
         frames, offsets[search_clip], lengths[search_clip], search_graph, problem_start, score_graph,
         tree.kernel_gaussians(), specs, first, n_paths, mode, return_paths,

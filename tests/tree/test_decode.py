@@ -95,7 +95,8 @@ def reference_beams(tree, graphs, clip, graph, n_paths, layer):
 
     A frame's candidates are the children of its kept nodes (slot ``side * width + w``);
     it keeps the ``n_paths`` with the best max-marginal (the numpy reference
-    ``max_marginals`` over the candidates' trellis), best first, -1 for none.
+    ``max_marginals`` over the candidates' trellis; ties to the lower slot), stored
+    in node order, -1 (no finite score) last.
     """
     from skmotion.tree import max_marginals
 
@@ -113,6 +114,8 @@ def reference_beams(tree, graphs, clip, graph, n_paths, layer):
         keep = np.argsort(-marginals, axis=1, kind="stable")[:, :n_paths]
         beam = np.take_along_axis(cand, keep, axis=1)
         beam[np.take_along_axis(marginals, keep, axis=1) == -np.inf] = -1
+        beam = np.sort(np.where(beam < 0, np.iinfo(int).max, beam), axis=1)
+        beam[beam == np.iinfo(int).max] = -1
     return beam
 
 
