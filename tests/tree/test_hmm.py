@@ -128,7 +128,8 @@ def test_the_papers_node_prior_gives_finite_answers(motions, graph):
     assert np.isfinite(model.score_samples(X[1::4])).all()
 
 
-def test_hard_cases_give_finite_answers():
+@pytest.mark.parametrize("score_layers", [1, "all"])
+def test_hard_cases_give_finite_answers(score_layers):
     rng = np.random.default_rng(0)
     X = [rng.normal(size=(n, 12)) for n in (40, 35, 50, 1, 2)]
     X[0][:, 3] = 1.5  # a constant channel
@@ -136,10 +137,12 @@ def test_hard_cases_give_finite_answers():
     y = ["a", "a", "b", "b", "c"]  # class "c" has one clip of two frames
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        model = MotionTreeHMM(min_samples_leaf=1, n_paths=5, covariance_type="full").fit(X, y)
+        model = MotionTreeHMM(min_samples_leaf=1, n_paths=5, covariance_type="full", score_layers=score_layers)
+        model.fit(X, y)
         for query in ([X[3]], [X[4]], [rng.normal(size=(1, 12)) * 100], [np.zeros((3, 12))]):
             assert np.isfinite(model.score_samples(query)).all()
             assert np.isfinite(model.predict_proba(query)).all()
+            assert model.predict(query)[0] in model.classes_
             assert len(model.decode(query)[0]) == len(query[0])
             assert np.isfinite(model.predict_next(query).probabilities).all()
     assert model.tree_.count.min() >= 1
