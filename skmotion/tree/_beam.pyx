@@ -38,6 +38,11 @@ cdef extern from "_emission.h" nogil:
                       double* out, Py_ssize_t stride)
     void skm_full_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* factor, const double* shift,
                       double c, double* out, Py_ssize_t stride, double* y)
+    void skm_lowrank_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* vectors,
+                         const double* w, Py_ssize_t r, double inv_floor, double c, double* out, Py_ssize_t stride,
+                         double* y)
+    void skm_step_all(const double* prev, const double** rows, const double* emit, Py_ssize_t n_cand, Py_ssize_t P,
+                      double* cur)
 
 #: What a call computes per problem; see :func:`decode_searches`.
 MODES = ("beam", "best", "kbest", "prune")
@@ -54,16 +59,21 @@ cdef struct Gaussians:
     const double* prec      # diag: (n_tree_nodes, d) precisions; full: (n_tree_nodes, d, d) upper factors
     const double* shifts    # full only: (n_tree_nodes, d), mean @ factor
     const double* const_    # (n_tree_nodes,)
+    const intp* lr_start    # full only: first row of a node's low-rank vectors, -1 for the factor
+    const intp* lr_rank
+    const double* lr_vectors
+    const double* lr_weights
+    const double* lr_inv_floor
     intp d
     bint full
 
 
 cdef struct Table:
-    const intp* indptr      # (n_graphs * K + 1,)
-    const intp* indices     # destination nodes of the stored transitions, sorted within a row
-    const double* seen      # their log probabilities
-    const double* unseen    # (n_graphs * K,) log probability of a transition never seen
-    const double* dense     # (K + 1, K + 1, n_graphs) log probabilities (K: no node), or NULL
+    const double* dense         # (K + 1, K + 1, n_graphs) log probabilities (K: no node), or NULL
+    const intp* pair_start      # (K + 1,): the transitions seen from node m are pairs pair_start[m]:pair_start[m + 1]
+    const intp* pair_dst        # their destinations, sorted within m
+    const double* pair_log      # (n_pairs, n_graphs) their log probabilities in every graph
+    const double* unseen_log    # (K + 1, n_graphs) a never-seen transition from each node; row K: -inf
     intp k
     intp n_graphs
 
@@ -84,29 +94,35 @@ cdef inline void _emissions(const Gaussians* g, const double* x, intp n, intp no
 
     Written to ``out[i * stride]``; ``y`` is scratch of ``4 d`` doubles.
     """
+    cdef intp row
     if g.full:
-        skm_full_run(x, n, g.d, g.prec + node * g.d * g.d, g.shifts + node * g.d, g.const_[node], out, stride, y)
+        row = g.lr_start[node]
+        if row >= 0:
+            skm_lowrank_run(x, n, g.d, g.means + node * g.d, g.lr_vectors + row * g.d, g.lr_weights + row,
+                            g.lr_rank[node], g.lr_inv_floor[node], g.const_[node], out, stride, y)
+        else:
+            skm_full_run(x, n, g.d, g.prec + node * g.d * g.d, g.shifts + node * g.d, g.const_[node], out, stride,
+                         y)
     else:
         skm_diag_run(x, n, g.d, g.means + node * g.d, g.prec + node * g.d, g.const_[node], out, stride)
 
 
-cdef inline double _transition(const Table* t, intp graph, intp src, intp dst) noexcept nogil:
-    """``log p(src -> dst)`` in a graph; -inf when either is "no node"."""
+cdef inline const double* _moves_of(const Table* t, intp src, intp dst) noexcept nogil:
+    """``log p(src -> dst)`` in every graph, ``n_graphs`` contiguous values; -inf when either is "no node"."""
+    if t.dense != NULL:  # no search and no branch: "no node" is row and column K
+        return t.dense + ((t.k if src < 0 else src) * (t.k + 1) + (t.k if dst < 0 else dst)) * t.n_graphs
     if src < 0 or dst < 0:
-        return -INFINITY
-    if t.dense != NULL:
-        return t.dense[(src * (t.k + 1) + dst) * t.n_graphs + graph]
-    cdef intp row = graph * t.k + src
-    cdef intp lo = t.indptr[row], hi = t.indptr[row + 1], end = t.indptr[row + 1], mid
+        return t.unseen_log + t.k * t.n_graphs
+    cdef intp lo = t.pair_start[src], hi = t.pair_start[src + 1], end = t.pair_start[src + 1], mid
     while lo < hi:
         mid = (lo + hi) >> 1
-        if t.indices[mid] < dst:
+        if t.pair_dst[mid] < dst:
             lo = mid + 1
         else:
             hi = mid
-    if lo < end and t.indices[lo] == dst:
-        return t.seen[lo]
-    return t.unseen[row]
+    if lo < end and t.pair_dst[lo] == dst:
+        return t.pair_log + lo * t.n_graphs
+    return t.unseen_log + src * t.n_graphs
 
 
 cdef bint _same_row(const intp* a, const intp* b, intp n) noexcept nogil:
@@ -124,25 +140,16 @@ cdef void _steps(intp n_steps, intp n_cand, const Table* tab, intp graph, const 
     A node stays for many frames, so the candidates of consecutive frames often
     repeat; the moves ``(n_cand, n_cand)`` are looked up again only when they change.
     """
-    cdef intp t, i, j, src, dst
+    cdef intp t, i, j, src
     cdef double* row
     cdef const double* move
-    cdef const double* base
     for t in range(n_steps - 1):
         if t == 0 or not (_same_row(cand + t * n_cand, cand + (t - 1) * n_cand, n_cand)
                           and _same_row(cand + (t + 1) * n_cand, cand + t * n_cand, n_cand)):
-            if tab.dense != NULL:  # no search and no branch: "no node" is row and column K, -inf
-                for i in range(n_cand):
-                    src = cand[t * n_cand + i]
-                    base = tab.dense + (tab.k if src < 0 else src) * (tab.k + 1) * tab.n_graphs + graph
-                    for j in range(n_cand):
-                        dst = cand[(t + 1) * n_cand + j]
-                        moves[i * n_cand + j] = base[(tab.k if dst < 0 else dst) * tab.n_graphs]
-            else:
-                for i in range(n_cand):
-                    src = cand[t * n_cand + i]
-                    for j in range(n_cand):
-                        moves[i * n_cand + j] = _transition(tab, graph, src, cand[(t + 1) * n_cand + j])
+            for i in range(n_cand):
+                src = cand[t * n_cand + i]
+                for j in range(n_cand):
+                    moves[i * n_cand + j] = _moves_of(tab, src, cand[(t + 1) * n_cand + j])[graph]
         for i in range(n_cand):
             row = steps + (t * n_cand + i) * n_cand
             move = moves + i * n_cand
@@ -294,6 +301,16 @@ cdef Gaussians _gaussians(object gauss):
     g.prec = &prec[0]
     g.shifts = &shifts[0, 0]
     g.const_ = &const_[0]
+    cdef const intp[::1] lr_start = gauss["lr_start"]
+    cdef const intp[::1] lr_rank = gauss["lr_rank"]
+    cdef const double[:, ::1] lr_vectors = gauss["lr_vectors"]
+    cdef const double[::1] lr_weights = gauss["lr_weights"]
+    cdef const double[::1] lr_inv_floor = gauss["lr_inv_floor"]
+    g.lr_start = &lr_start[0]
+    g.lr_rank = &lr_rank[0]
+    g.lr_vectors = &lr_vectors[0, 0] if lr_vectors.shape[0] else NULL
+    g.lr_weights = &lr_weights[0] if lr_weights.shape[0] else NULL
+    g.lr_inv_floor = &lr_inv_floor[0]
     g.d = means.shape[1]
     g.full = gauss["full"]
     return g
@@ -301,18 +318,18 @@ cdef Gaussians _gaussians(object gauss):
 
 cdef Table _table(object table):
     cdef Table t
-    cdef const intp[::1] indptr = table[0]
-    cdef const intp[::1] indices = table[1]
-    cdef const double[::1] seen = table[2]
-    cdef const double[::1] unseen = table[3]
-    cdef const double[::1] dense = table[5]
-    t.indptr = &indptr[0]
-    t.indices = &indices[0] if indices.shape[0] else NULL
-    t.seen = &seen[0] if seen.shape[0] else NULL
-    t.unseen = &unseen[0]
+    cdef const intp[::1] pair_start = table["pair_start"]
+    cdef const intp[::1] pair_dst = table["pair_dst"]
+    cdef const double[:, ::1] pair_log = table["pair_log"]
+    cdef const double[:, ::1] unseen_log = table["unseen_log"]
+    cdef const double[::1] dense = table["dense"]
+    t.pair_start = &pair_start[0]
+    t.pair_dst = &pair_dst[0] if pair_dst.shape[0] else NULL
+    t.pair_log = &pair_log[0, 0] if pair_log.shape[0] else NULL
+    t.unseen_log = &unseen_log[0, 0]
     t.dense = &dense[0] if dense.shape[0] else NULL
-    t.k = table[4]
-    t.n_graphs = table[6]
+    t.k = table["k"]
+    t.n_graphs = table["n_graphs"]
     return t
 
 
@@ -351,17 +368,23 @@ cdef struct Work:
     double* scratch
     intp* head
     intp* back          # (T, n_paths, 2 n_paths), or NULL when no paths are wanted
+    double* moves_all   # (2 n_paths, 2 n_paths, P): the moves in each of a search's P graphs, gathered
+    const double** move_rows  # (2 n_paths, 2 n_paths): where each pair's P moves are
+    double* prev_all    # (2 n_paths, P)
+    double* cur_all
     double* y           # (4 d,)
 
 
 cdef void _free_work(Work* w) noexcept:
     free(w.beam); free(w.next_beam); free(w.beam_emit); free(w.next_emit); free(w.cand); free(w.emit)
     free(w.masked); free(w.steps); free(w.fwd); free(w.bwd); free(w.moves); free(w.delta); free(w.scratch)
-    free(w.head); free(w.back); free(w.y)
+    free(w.head); free(w.back); free(w.y); free(w.moves_all); free(w.move_rows); free(w.prev_all)
+    free(w.cur_all)
 
 
-cdef bint _alloc_work(Work* w, intp max_steps, intp n_paths, intp slots, intp d, bint paths) noexcept:
-    cdef intp t = max(max_steps, 1), nc = 2 * n_paths
+cdef bint _alloc_work(Work* w, intp max_steps, intp n_paths, intp slots, intp d, bint paths,
+                      intp max_graphs) noexcept:
+    cdef intp t = max(max_steps, 1), nc = 2 * n_paths, g = max(max_graphs, 1)
     w.beam = <intp*> malloc(t * n_paths * sizeof(intp))
     w.next_beam = <intp*> malloc(t * n_paths * sizeof(intp))
     w.beam_emit = <double*> malloc(t * n_paths * sizeof(double))
@@ -378,10 +401,15 @@ cdef bint _alloc_work(Work* w, intp max_steps, intp n_paths, intp slots, intp d,
     w.head = <intp*> malloc(nc * sizeof(intp))
     w.back = <intp*> malloc(t * n_paths * nc * sizeof(intp)) if paths else NULL
     w.y = <double*> malloc(4 * max(d, 1) * sizeof(double))
+    w.moves_all = <double*> malloc(nc * nc * g * sizeof(double))
+    w.move_rows = <const double**> malloc(nc * nc * sizeof(double*))
+    w.prev_all = <double*> malloc(nc * g * sizeof(double))
+    w.cur_all = <double*> malloc(nc * g * sizeof(double))
     return not (w.beam == NULL or w.next_beam == NULL or w.beam_emit == NULL or w.next_emit == NULL
                 or w.cand == NULL or w.emit == NULL or w.masked == NULL or w.steps == NULL or w.fwd == NULL
                 or w.bwd == NULL or w.moves == NULL or w.delta == NULL or w.scratch == NULL or w.head == NULL
-                or (paths and w.back == NULL) or w.y == NULL)
+                or (paths and w.back == NULL) or w.y == NULL or w.moves_all == NULL or w.move_rows == NULL or w.prev_all == NULL
+                or w.cur_all == NULL)
 
 
 cdef intp _candidates(const Layer* lay, intp n_steps, intp width, intp search_graph, bint carry,
@@ -474,6 +502,56 @@ cdef intp _keep(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const
     return keep
 
 
+cdef void _best_all(intp n_steps, intp n_cand, const Table* tab, const intp* graphs, intp n_graphs,
+                    const intp* cand, const double* emit, Work* w, double* out, intp out_stride) noexcept nogil:
+    """The best sequence's score under each of a search's graphs at once.
+
+    The graphs share the candidates and their emissions, and the table holds
+    one transition of every graph contiguously: each step runs over the graphs
+    in the innermost loop, which the compiler vectorises. When the graphs are
+    the table's in order (as MotionTreeHMM asks), that loop reads the table in
+    place; otherwise their values are gathered first. The sums are those of
+    :func:`_best` for each graph alone, in the same order.
+    """
+    cdef intp t, i, j, q, src, P = n_graphs
+    cdef double best
+    cdef double* prev = w.prev_all
+    cdef double* cur = w.cur_all
+    cdef double* tmp
+    cdef double* gathered
+    cdef const double* base
+    cdef bint in_order = True
+    for q in range(1, P):
+        in_order = in_order and graphs[q] == graphs[0] + q
+    for j in range(n_cand):
+        for q in range(P):
+            prev[j * P + q] = emit[j]
+    for t in range(1, n_steps):
+        if t == 1 or not (_same_row(cand + (t - 1) * n_cand, cand + (t - 2) * n_cand, n_cand)
+                          and _same_row(cand + t * n_cand, cand + (t - 1) * n_cand, n_cand)):
+            for i in range(n_cand):
+                src = cand[(t - 1) * n_cand + i]
+                for j in range(n_cand):
+                    base = _moves_of(tab, src, cand[t * n_cand + j])
+                    if in_order:
+                        w.move_rows[i * n_cand + j] = base + graphs[0]
+                    else:
+                        gathered = w.moves_all + (i * n_cand + j) * P
+                        for q in range(P):
+                            gathered[q] = base[graphs[q]]
+                        w.move_rows[i * n_cand + j] = gathered
+        skm_step_all(prev, w.move_rows, emit + t * n_cand, n_cand, P, cur)
+        tmp = prev
+        prev = cur
+        cur = tmp
+    for q in range(P):
+        best = -INFINITY
+        for j in range(n_cand):
+            if prev[j * P + q] > best:
+                best = prev[j * P + q]
+        out[q * out_stride] = best
+
+
 cdef void _score(intp mode, intp n_steps, intp n_cand, intp n_paths, const Layer* lay, intp graph,
                  const intp* cand, const double* emit, Work* w, double* scores, intp* paths,
                  intp path_stride) noexcept nogil:
@@ -549,7 +627,7 @@ def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, co
     cdef intp n_layers = len(layers) - 1, n_searches = frame_start.shape[0]
     cdef intp n_problems = score_graph.shape[0]
     cdef intp n_scored = 0 if imode == BEAM else n_layers - first_scored + 1
-    cdef intp max_steps = 0, total_steps = 0, s, p, l, t, r, li, width, n_cand, slot, n_live
+    cdef intp max_steps = 0, total_steps = 0, max_graphs = 0, s, p, l, t, r, li, width, n_cand, slot, n_live
     cdef intp slots = 1 + (n_scored if imode == PRUNE else 0)
     cdef double top, margin
     cdef bint carry, scored, need, paths_now
@@ -558,6 +636,7 @@ def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, co
     for s in range(n_searches):
         max_steps = max(max_steps, n_steps[s])
         total_steps += n_steps[s]
+        max_graphs = max(max_graphs, problem_start[s + 1] - problem_start[s])
     cdef Gaussians g = _gaussians(gauss)
     cdef Layer* lays = <Layer*> malloc((n_layers + 1) * sizeof(Layer))
     if lays == NULL:
@@ -578,7 +657,7 @@ def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, co
     cdef double* best_sum = <double*> malloc(max(n_problems, 1) * sizeof(double))
     cdef bint* live = <bint*> malloc(max(n_problems, 1) * sizeof(bint))
     cdef Work w
-    cdef bint ok = _alloc_work(&w, max_steps, n_paths, slots, g.d, want_paths)
+    cdef bint ok = _alloc_work(&w, max_steps, n_paths, slots, g.d, want_paths, max_graphs)
     if not ok or best_widths == NULL or best_sum == NULL or live == NULL:
         _free_work(&w); free(lays); free(best_widths); free(best_sum); free(live)
         raise MemoryError(f"decoding {max_steps} frames with {2 * n_paths} candidates each")
@@ -611,11 +690,17 @@ def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, co
                     if scored:
                         best_widths[li] = n_cand
                         paths_now = want_paths and l == n_layers and imode == KBEST
-                        for p in range(problem_start[s], problem_start[s + 1]):
-                            _score(BEST if imode == PRUNE else imode, n_steps[s], n_cand, n_paths, &lays[l],
-                                   score_graph[p], cand, emit, &w, &scores[p, li, 0],
-                                   &paths[p, 0, 0] if paths_now else NULL, max_steps)
-                            if imode == PRUNE:
+                        p = problem_start[s]
+                        if imode != KBEST and lays[l].score_allowed == NULL and problem_start[s + 1] > p:
+                            _best_all(n_steps[s], n_cand, &lays[l].score, &score_graph[p], problem_start[s + 1] - p,
+                                      cand, emit, &w, &scores[p, li, 0], n_scored * n_paths)
+                        else:
+                            for p in range(problem_start[s], problem_start[s + 1]):
+                                _score(BEST if imode == PRUNE else imode, n_steps[s], n_cand, n_paths, &lays[l],
+                                       score_graph[p], cand, emit, &w, &scores[p, li, 0],
+                                       &paths[p, 0, 0] if paths_now else NULL, max_steps)
+                        if imode == PRUNE:
+                            for p in range(problem_start[s], problem_start[s + 1]):
                                 best_sum[p] += scores[p, li, 0]
                     if l < n_layers or imode == BEAM:
                         width = _keep(n_steps[s], n_cand, n_paths, cand, emit, need, &lays[l].search,

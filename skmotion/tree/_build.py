@@ -13,7 +13,7 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.linalg.lapack import dsyevr
 
-from skmotion.tree._gaussian import centred_moments, estimate_covariance
+from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
 from skmotion.tree._split import best_split
 
 __all__ = ["build_nodes"]
@@ -80,12 +80,14 @@ class _Builder:
         self.min_leaf = min_samples_leaf
         self.split = split
         self.kind = covariance_type
-        self.nodes = {k: [] for k in ("parent", "depth", "start", "stop", "mean", "cov", "axis", "thr", "left", "right")}
+        self.nodes = {k: [] for k in ("parent", "depth", "start", "stop", "mean", "cov", "low_rank", "axis", "thr",
+                                      "left", "right")}
 
     def add(self, parent, depth, start, stop):
         for key, value in zip(("parent", "depth", "start", "stop"), (parent, depth, start, stop)):
             self.nodes[key].append(value)
-        for key, value in (("left", -1), ("right", -1), ("axis", None), ("thr", np.nan), ("mean", None), ("cov", None)):
+        for key, value in (("left", -1), ("right", -1), ("axis", None), ("thr", np.nan), ("mean", None), ("cov", None),
+                           ("low_rank", None)):
             self.nodes[key].append(value)
         return len(self.nodes["parent"]) - 1
 
@@ -102,6 +104,8 @@ class _Builder:
             self.root_scatter = scatter
         nodes["mean"][node] = mean
         nodes["cov"][node] = estimate_covariance(scatter, sq_norms, self.kind, self.reg)
+        if self.kind == "full" and n <= d:  # fewer frames than channels: the covariance is low rank plus a floor
+            nodes["low_rank"][node] = low_rank_covariance(block - mean, scatter, sq_norms, self.reg)
         if not (may_split and n >= self.min_split):
             return ()
         axis = _principal_axis(block - mean if n < d else None, scatter)
@@ -160,7 +164,9 @@ def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, cov
     -------
     nodes : dict
         ``parent``, ``left``, ``right``, ``depth``, ``count``, ``mean``,
-        ``covariance``, ``axis``, ``threshold`` (per tree node id), ``layers``,
+        ``covariance``, ``low_rank`` (a list; see ``low_rank_covariance``, None for
+        a node with more frames than channels or another covariance type),
+        ``axis``, ``threshold`` (per tree node id), ``layers``,
         ``principal_axes`` (the first three axes of all frames) and ``reg`` (the
         absolute regularisation): the arguments of ``MotionTree``.
     """
@@ -176,6 +182,7 @@ def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, cov
         "count": np.array(nodes["stop"], dtype=np.intp) - np.array(nodes["start"], dtype=np.intp),
         "mean": np.array(nodes["mean"]),
         "covariance": np.array(nodes["cov"]),
+        "low_rank": nodes["low_rank"],
         "axis": np.array([np.zeros(d) if a is None else a for a in nodes["axis"]]),
         "threshold": np.array(nodes["thr"], dtype=np.float64),
         "layers": layers,

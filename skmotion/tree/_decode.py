@@ -241,12 +241,11 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         Classification only, with a ``guide``: run the K-best passes only on the
         problems that may hold the highest summed score of their clip (the
         clip's problems share its search, so this is decided per search, with
-        nothing recomputed). At each scored layer the
-        sum of ``n_paths`` sequences lies between the best one and ``n_paths``
-        times it, so a problem whose best sequences (summed over the scored
-        layers) score more than ``n_scored log(n_paths)`` below those of another
-        problem of the same clip can never win; it gets ``-inf`` scores and -1
-        paths. A clip left with one problem has its winner: that problem gets
+        nothing recomputed). At each scored layer the sum of ``n_paths``
+        sequences lies between the best one and ``n_paths`` times it, so a
+        problem whose best sequences (summed over the scored layers) score
+        more than ``n_scored log(n_paths)`` below those of another problem of
+        the same clip can never win; it gets ``-inf`` scores and -1 paths. A clip left with one problem has its winner: that problem gets
         only its best sequences' scores (the others ``-inf``) and -1 paths.
         Which problem wins is unchanged.
     return_paths : bool, default=True
@@ -299,11 +298,12 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         problem_start = np.arange(n_problems + 1, dtype=np.intp)
         score_graph = graph_of_problem
     else:  # one search per clip under the guide, shared by the clip's problems
-        order = np.argsort(clip_of_problem, kind="stable")
+        # (problems in clip order, as MotionTreeHMM gives them, need no reordering)
+        order = None if (np.diff(clip_of_problem) >= 0).all() else np.argsort(clip_of_problem, kind="stable")
         search_clip, per_clip = np.unique(clip_of_problem, return_counts=True)
         search_graph, search = np.zeros(len(search_clip), dtype=np.intp), guide
         problem_start = np.concatenate([[0], np.cumsum(per_clip)]).astype(np.intp)
-        score_graph = np.ascontiguousarray(graph_of_problem[order])
+        score_graph = graph_of_problem if order is None else np.ascontiguousarray(graph_of_problem[order])
     specs = _layer_specs(tree, search, graphs, layer, node_prior, mask_scored=guide is not None)
     # One sequence and no paths: the forward pass alone gives its score.
     mode = "best" if n_paths == 1 and not return_paths else "prune" if prune and n_paths > 1 else "kbest"

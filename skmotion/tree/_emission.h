@@ -1,4 +1,4 @@
-/* Gaussian log densities of the compiled decoder (skmotion/tree/_beam.pyx).
+/* Vectorised loops of the compiled decoder (skmotion/tree/_beam.pyx): Gaussian log densities.
  *
  * Each density is a sum over the channels. Written as a plain loop, the sum is a
  * chain of dependent additions that a compiler may not reorder (that would change
@@ -12,7 +12,10 @@
  * the node's parameters and give four independent chains of additions (a single
  * sum waits on its own latency).
  *
- * With GCC on x86-64 Linux the run functions are built twice, for AVX2 and for the
+ * It also holds the one step of the decoder's max-product pass that runs over several
+ * graphs at once (skm_step_all): the graphs are its vector lanes.
+ *
+ * With GCC on x86-64 Linux these functions are built twice, for AVX2 and for the
  * baseline, and the loader picks the one the processor runs (`target_clones`): the
  * package stays portable, and AVX2 halves the time of these loops where present.
  * The AVX2 build does not fuse multiply-adds, so both give the same sums.
@@ -132,6 +135,77 @@ SKM_DISPATCH static void skm_full_run(const double *x, Py_ssize_t n, Py_ssize_t 
     }
     for (; i < n; i++)
         out[i * stride] = c - 0.5 * skm_full_maha(x + i * d, factor, shift, d, y);
+}
+
+/* out[i * stride] = c - maha(x_i) / 2 for the n frames x_i = x + i d, full Gaussian in
+ * low-rank form, covariance floor I + V^T diag(values) V with r orthonormal rows v_k:
+ * maha = |y|^2 / floor - sum_k w_k (v_k . y)^2, y = x - mu, w_k = values_k / (floor
+ * (floor + values_k)) (Woodbury). O(r d) where the triangular factor costs O(d^2 / 2).
+ * y is scratch of d. */
+SKM_DISPATCH static void skm_lowrank_run(const double *x, Py_ssize_t n, Py_ssize_t d, const double *mu,
+                                         const double *vectors, const double *w, Py_ssize_t r, double inv_floor,
+                                         double c, double *out, Py_ssize_t stride, double *y)
+{
+    Py_ssize_t i, a, k;
+    for (i = 0; i < n; i++) {
+        const double *xi = x + i * d;
+        double s = 0.0;
+#pragma omp simd reduction(+:s)
+        for (a = 0; a < d; a++) {
+            y[a] = xi[a] - mu[a];
+            s += y[a] * y[a];
+        }
+        s *= inv_floor;
+        /* four projections at a time: four independent sums */
+        for (k = 0; k + 4 <= r; k += 4) {
+            const double *v0 = vectors + k * d, *v1 = v0 + d, *v2 = v1 + d, *v3 = v2 + d;
+            double p0 = 0.0, p1 = 0.0, p2 = 0.0, p3 = 0.0;
+#pragma omp simd reduction(+:p0, p1, p2, p3)
+            for (a = 0; a < d; a++) {
+                p0 += v0[a] * y[a];
+                p1 += v1[a] * y[a];
+                p2 += v2[a] * y[a];
+                p3 += v3[a] * y[a];
+            }
+            s -= w[k] * p0 * p0 + w[k + 1] * p1 * p1 + w[k + 2] * p2 * p2 + w[k + 3] * p3 * p3;
+        }
+        for (; k < r; k++) {
+            const double *v = vectors + k * d;
+            double p = 0.0;
+#pragma omp simd reduction(+:p)
+            for (a = 0; a < d; a++)
+                p += v[a] * y[a];
+            s -= w[k] * p * p;
+        }
+        out[i * stride] = c - 0.5 * s;
+    }
+}
+
+/* One step of the max-product pass of several graphs at once: for every slot j,
+ * cur[j][q] = max_i prev[i][q] + (rows[i n_cand + j][q] + emit[j]) over the P graphs q
+ * (rows[...] points at a candidate pair's P transition log probabilities). The sums
+ * and their order are those of one graph's pass; the graphs are the vector lanes. */
+SKM_DISPATCH static void skm_step_all(const double *prev, const double *const *rows, const double *emit,
+                                      Py_ssize_t n_cand, Py_ssize_t P, double *cur)
+{
+    Py_ssize_t i, j, q;
+    for (j = 0; j < n_cand; j++) {
+        const double e = emit[j];
+        double *out = cur + j * P;
+        const double *mv = rows[j];
+#pragma omp simd
+        for (q = 0; q < P; q++)
+            out[q] = prev[q] + (mv[q] + e);
+        for (i = 1; i < n_cand; i++) {
+            const double *pi = prev + i * P;
+            mv = rows[i * n_cand + j];
+#pragma omp simd
+            for (q = 0; q < P; q++) {
+                const double v = pi[q] + (mv[q] + e);
+                out[q] = v > out[q] ? v : out[q];
+            }
+        }
+    }
 }
 
 #endif

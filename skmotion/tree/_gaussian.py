@@ -13,7 +13,8 @@ change; its covariance must still be invertible. Three estimators are offered:
 import numpy as np
 from scipy.linalg import solve_triangular
 
-__all__ = ["COVARIANCE_TYPES", "Gaussians", "centred_moments", "estimate_covariance", "ledoit_wolf_shrinkage"]
+__all__ = ["COVARIANCE_TYPES", "Gaussians", "centred_moments", "estimate_covariance", "ledoit_wolf_shrinkage",
+           "low_rank_covariance"]
 
 #: The covariance estimators of :func:`estimate_covariance`.
 COVARIANCE_TYPES = ("diag", "full", "spherical")
@@ -125,13 +126,64 @@ def estimate_covariance(scatter, sq_norms, kind, reg):
     if kind == "spherical":
         return float(np.trace(scatter) / (n * d) + reg)
     if kind == "full":
-        sample = scatter / n
-        shrink = ledoit_wolf_shrinkage(scatter, sq_norms)
-        mu = np.trace(sample) / d
-        covariance = (1.0 - shrink) * sample
-        covariance[np.diag_indices_from(covariance)] += shrink * mu + reg
+        scale, floor = _ledoit_wolf_parts(scatter, sq_norms, reg)
+        covariance = scale * scatter
+        covariance[np.diag_indices_from(covariance)] += floor
         return covariance
     raise ValueError(f"covariance_type must be one of {COVARIANCE_TYPES}, got {kind!r}.")
+
+
+def _ledoit_wolf_parts(scatter, sq_norms, reg):
+    """The full estimate as ``scale * scatter + floor * I``: ``(1 - s) / n`` and ``s mu + reg``."""
+    n, d = len(sq_norms), len(scatter)
+    shrink = ledoit_wolf_shrinkage(scatter, sq_norms)
+    return (1.0 - shrink) / n, shrink * np.trace(scatter) / (n * d) + reg
+
+
+def low_rank_covariance(centred, scatter, sq_norms, reg):
+    """The ``"full"`` estimate of a node as an isotropic part plus a low-rank one.
+
+    The shrunk sample covariance is ``floor I + scale X^T X`` with ``X`` the
+    node's centred frames, whose rank is below the frame count: with fewer
+    frames than channels, ``floor I + V^T diag(values) V`` with ``r`` rows of
+    ``V`` is the same matrix, and a density costs ``O(r d)`` instead of ``O(d^2)``.
+
+    Parameters
+    ----------
+    centred : ndarray of shape (n_frames, n_channels)
+        The node's frames minus their mean.
+    scatter, sq_norms : ndarray
+        Their centred moments (see :func:`centred_moments`).
+    reg : float
+        As for :func:`estimate_covariance`.
+
+    Returns
+    -------
+    floor : float
+        The isotropic part.
+    vectors : ndarray of shape (r, n_channels)
+        Orthonormal rows: the directions the frames span.
+    values : ndarray of shape (r,)
+        The covariance's excess over ``floor`` along each of them.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
+    >>> frames = np.random.default_rng(0).normal(size=(4, 10))
+    >>> mean, scatter, sq_norms = centred_moments(frames)
+    >>> floor, vectors, values = low_rank_covariance(frames - mean, scatter, sq_norms, 1e-3)
+    >>> vectors.shape
+    (3, 10)
+    >>> full = estimate_covariance(scatter, sq_norms, "full", 1e-3)
+    >>> np.allclose(floor * np.eye(10) + vectors.T @ np.diag(values) @ vectors, full)
+    True
+    """
+    scale, floor = _ledoit_wolf_parts(scatter, sq_norms, reg)
+    _, singular, vectors = np.linalg.svd(centred, full_matrices=False)
+    # the centred frames' rank is below their count: their last singular values are rounding
+    keep = singular > singular[:1].max(initial=0.0) * 1e-12
+    return floor, vectors[keep], scale * singular[keep] ** 2
 
 
 class Gaussians:
@@ -147,6 +199,11 @@ class Gaussians:
         positive definite.
     kind : {"diag", "full", "spherical"}
         How ``covariances`` is laid out.
+    low_rank : list, default=None
+        For ``"full"``, per Gaussian the ``(floor, vectors, values)`` of
+        :func:`low_rank_covariance` or None: the compiled decoder evaluates a
+        Gaussian whose rank is small against the channels in that form.
+        ``log_pdf`` always uses the Cholesky factor (the reference).
 
     Examples
     --------
@@ -157,12 +214,13 @@ class Gaussians:
     -1.8379
     """
 
-    def __init__(self, means, covariances, kind):
+    def __init__(self, means, covariances, kind, low_rank=None):
         if kind not in COVARIANCE_TYPES:
             raise ValueError(f"kind must be one of {COVARIANCE_TYPES}, got {kind!r}.")
         self.means = np.asarray(means, dtype=np.float64)
         self.covariances = np.asarray(covariances, dtype=np.float64)
         self.kind = kind
+        self.low_rank = low_rank
         n_nodes, d = self.means.shape
         if kind == "full":
             chol = np.linalg.cholesky(self.covariances)
@@ -194,7 +252,12 @@ class Gaussians:
             and ``"spherical"``, the latter repeated over channels) or flat upper
             triangular factors ``U`` with ``U U^T`` the precision (``"full"``);
             ``shifts`` ``(n, d)``, ``mean @ U`` (a ``(1, 1)`` placeholder otherwise);
-            ``const`` ``(n,)``; ``full``.
+            ``const`` ``(n,)``; ``full``. For the Gaussians of ``"full"`` taken
+            in low-rank form (``floor I + V^T diag(values) V``), ``lr_start[k]``
+            is the first row of ``lr_vectors`` ``(R, d)`` of Gaussian ``k`` and
+            ``lr_rank[k]`` their count, ``lr_weights`` ``(R,)`` holds
+            ``values / (floor (floor + values))`` and ``lr_inv_floor[k]`` is
+            ``1 / floor``; ``lr_start[k]`` is -1 for the others, which use ``U``.
         """
         return self._kernel
 
@@ -211,6 +274,29 @@ class Gaussians:
             "shifts": np.ascontiguousarray(shifts, dtype=np.float64),
             "const": np.ascontiguousarray(self._const, dtype=np.float64),
             "full": self.kind == "full",
+            **self._low_rank_arrays(),
+        }
+
+    def _low_rank_arrays(self):
+        """The low-rank form of the Gaussians where it is cheaper: ``O(r d)`` against ``O(d^2 / 2)``."""
+        n, d = self.means.shape
+        start, rank = np.full(n, -1, dtype=np.intp), np.zeros(n, dtype=np.intp)
+        inv_floor = np.zeros(n)
+        vectors, weights, row = [np.zeros((0, d))], [np.zeros(0)], 0
+        for k, parts in enumerate(self.low_rank if self.kind == "full" and self.low_rank is not None else ()):
+            if parts is None or 4 * (len(parts[1]) + 2) > d:  # the triangular factor is as cheap
+                continue
+            floor, vecs, values = parts
+            start[k], rank[k], inv_floor[k] = row, len(vecs), 1.0 / floor
+            vectors.append(vecs)
+            weights.append(values / (floor * (floor + values)))
+            row += len(vecs)
+        return {
+            "lr_start": start,
+            "lr_rank": rank,
+            "lr_vectors": np.ascontiguousarray(np.vstack(vectors), dtype=np.float64),
+            "lr_weights": np.concatenate(weights),
+            "lr_inv_floor": inv_floor,
         }
 
     def log_pdf(self, X, nodes=None):

@@ -20,6 +20,7 @@ from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["MotionTreeHMM"]
 
+
 def _logsumexp(a, axis, keepdims=False):
     """``log sum exp`` along an axis; ``-inf`` where every term is.
 
@@ -31,6 +32,19 @@ def _logsumexp(a, axis, keepdims=False):
     with np.errstate(divide="ignore"):
         out = np.log(np.sum(np.exp(a - top), axis=axis, keepdims=True)) + top
     return out if keepdims else np.squeeze(out, axis=axis)
+
+
+def _sum_of_paths(scores):
+    """``log sum exp`` over the last axis of lists sorted best first (as the decoder returns them).
+
+    The best is the maximum, so no search for it: ``best + log1p(sum exp(rest - best))``.
+    """
+    best = scores[..., 0]
+    if scores.shape[-1] == 1:
+        return best
+    finite = np.isfinite(best)
+    rest = np.exp(scores[..., 1:] - np.where(finite, best, 0.0)[..., None]).sum(axis=-1)
+    return np.where(finite, best + np.log1p(rest), best)
 
 
 def _check_count(name, value, low=1):
@@ -154,9 +168,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     finite scores. Building costs O(N log N) for N frames when the tree is
     about ``log N`` deep.
 
-    With ``node_prior="layer"`` the layers above ``layer_`` are searched once
-    per clip on the global graph, and each class's (or clip's) graph runs the
-    last K-best pass on the candidates that leaves; this shared beam gave the
+    With ``node_prior="layer"`` the beams are searched once per clip on the
+    global graph, and each class's (or clip's) graph runs its K-best passes at
+    the scored layers on the candidates that leaves; this shared beam gave the
     same accuracy as one search per graph in our measurements, for a fraction
     of the work. The normaliser of ``Ps`` is then the same for every graph, so
     ``predict``, ``predict_proba`` and ``decode`` skip it; ``score_samples``
@@ -322,7 +336,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         """
         _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_),
                                  score_layers=len(self.score_layers_), exact=exact, prune=prune, paths=False)
-        per_graph = _logsumexp(scores, axis=3).sum(axis=2)
+        per_graph = _sum_of_paths(scores).sum(axis=2)
         if self.graph == "class":
             return per_graph
         out = np.full((len(clips), len(self.classes_)), -np.inf)

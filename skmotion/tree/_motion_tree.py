@@ -58,6 +58,10 @@ class MotionTree:
         Split threshold on ``frame @ axis`` (NaN for leaves).
     layers : list of ndarray
         Tree node ids of each layer, in tree order.
+    low_rank : list
+        For ``"full"``, each node's covariance as ``(floor, vectors, values)``,
+        ``floor I + vectors.T @ diag(values) @ vectors``, when the node has no
+        more frames than channels (see ``low_rank_covariance``); else None.
     covariance_type : str
         The covariance estimator.
     reg : float
@@ -79,7 +83,7 @@ class MotionTree:
     """
 
     def __init__(self, *, parent, left, right, depth, count, mean, covariance, axis, threshold, layers,
-                 covariance_type, reg, principal_axes):
+                 covariance_type, reg, principal_axes, low_rank=None):
         self.parent = parent
         self.left = left
         self.right = right
@@ -93,7 +97,8 @@ class MotionTree:
         self.covariance_type = covariance_type
         self.reg = reg
         self.principal_axes = principal_axes
-        self._gaussians = Gaussians(mean, covariance, covariance_type)
+        self.low_rank = [None] * len(parent) if low_rank is None else low_rank
+        self._gaussians = Gaussians(mean, covariance, covariance_type, self.low_rank)
         self._kernel_children = [np.ascontiguousarray(self.children(layer)) for layer in range(len(layers))]
 
     @classmethod

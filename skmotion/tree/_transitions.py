@@ -27,6 +27,10 @@ __all__ = ["TransitionGraphs"]
 # Graphs whose dense table (n_graphs * K * K) is at most this many entries keep
 # one, so lookups are one gather instead of a binary search.
 _DENSE_LIMIT = 1 << 21
+# The compiled decoder reads a dense table up to 8 MB; beyond, a cache miss per
+# lookup costs more than the short search in a node's row of seen transitions
+# (measured on JapaneseVowels' trees: 256 KB and 2 MB limits were slower).
+_KERNEL_DENSE_LIMIT = 1 << 20
 
 
 class TransitionGraphs:
@@ -149,30 +153,46 @@ class TransitionGraphs:
     def kernel_table(self, layer):
         """A layer's log probabilities as the compiled decoder reads them (:mod:`skmotion.tree._beam`).
 
-        Made once, when the graphs are.
+        Made once, when the graphs are. The decoder asks for one transition in
+        every graph at once, so the values of all graphs are contiguous.
 
         Returns
         -------
-        table : tuple
-            ``(indptr, indices, seen, unseen, K, dense, n_graphs)``: row ``g K + m``
-            of the count matrix lists the nodes ``indices[indptr[r]:indptr[r + 1]]``
-            (sorted) that ``m`` moved to in graph ``g``, ``seen`` their log
-            probabilities, and ``unseen[r]`` that of every other node; ``dense``
-            is the flat ``(K + 1, K + 1, n_graphs)`` table of all of them where
-            it is small enough to keep (a lookup without a search), else empty.
+        table : dict
+            ``k`` (nodes) and ``n_graphs``; ``pair_start`` ``(K + 1,)``: the
+            transitions seen from node ``m`` in any graph are entries
+            ``pair_start[m]:pair_start[m + 1]``, with destinations ``pair_dst``
+            (sorted) and log probabilities ``pair_log`` ``(n_pairs, n_graphs)``
+            (a graph that never made one has its unseen value there);
+            ``unseen_log`` ``(K + 1, n_graphs)``: a never-seen transition from
+            each node, and ``-inf`` in row ``K`` ("no node"); ``dense``: the
+            flat ``(K + 1, K + 1, n_graphs)`` table of them all where it is small
+            enough to stay in a processor cache (a lookup without a search), else empty.
         """
         return self._kernel[layer]
 
     def _kernel_table(self, layer):
         csr = self._counts[layer]
-        k = self.n_nodes(layer)
+        k, n_graphs = self.n_nodes(layer), self.n_graphs
         rows = np.repeat(np.arange(csr.shape[0]), np.diff(csr.indptr))
-        denominator = self._totals[layer].ravel() + self.smoothing
-        # The same expression as log_prob's, so both give the same doubles.
-        seen = np.log((csr.data + self.pseudo_count(layer)) / denominator[rows])
+        graph, src = np.divmod(rows, k)
+        denominator = self._totals[layer] + self.smoothing  # (n_graphs, K)
+        # The same expressions as log_prob's, so both give the same doubles.
         unseen = np.log((0 + self.pseudo_count(layer)) / denominator)
-        dense = self._dense[layer] if self._dense[layer] is not None else np.zeros(0)
-        return (csr.indptr.astype(np.intp), csr.indices.astype(np.intp), seen, unseen, k, dense, self.n_graphs)
+        pairs, pair_of_entry = np.unique(src * k + csr.indices, return_inverse=True)
+        pair_src, pair_dst = np.divmod(pairs, k)
+        pair_log = np.ascontiguousarray(unseen[:, pair_src].T)
+        pair_log[pair_of_entry, graph] = np.log((csr.data + self.pseudo_count(layer)) / denominator[graph, src])
+        small = n_graphs * (k + 1) ** 2 <= _KERNEL_DENSE_LIMIT and self._dense[layer] is not None
+        return {
+            "k": k,
+            "n_graphs": n_graphs,
+            "pair_start": np.searchsorted(pair_src, np.arange(k + 1)).astype(np.intp),
+            "pair_dst": pair_dst.astype(np.intp),
+            "pair_log": pair_log.reshape(-1, n_graphs),
+            "unseen_log": np.ascontiguousarray(np.vstack([unseen.T, np.full((1, n_graphs), -np.inf)])),
+            "dense": self._dense[layer] if small else np.zeros(0),
+        }
 
     def n_nodes(self, layer):
         """Number of nodes of a layer."""

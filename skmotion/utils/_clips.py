@@ -202,6 +202,50 @@ def _check_feature_names(X, estimator, reset, input_name):
     )
 
 
+def _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name):
+    """The clips of a collection as C-contiguous float arrays, checked one by one; and their channel count."""
+    clips = []
+    n_channels = None
+    for i, clip in enumerate(raw):
+        arr, target = _as_float_clip(clip, i, dtypes, input_name)
+        if arr.ndim != 2:
+            raise ValueError(
+                f"{input_name}: clip {i} is {arr.ndim}-D with shape {arr.shape}; "
+                "expected a 2-D array of shape (n_frames, n_channels)"
+                + (" (use clip.reshape(-1, 1) for one channel)." if arr.ndim == 1 else ".")
+            )
+        if arr.shape[0] == 0 and min_frames > 0:
+            raise ValueError(f"{input_name}: clip {i} has no frames.")
+        if arr.shape[1] == 0:
+            raise ValueError(f"{input_name}: clip {i} has no channels.")
+        if arr.shape[0] < min_frames:
+            raise ValueError(
+                f"{input_name}: clip {i} has {arr.shape[0]} frame(s); {name} needs "
+                f"at least {min_frames}."
+            )
+        if n_channels is None:
+            n_channels = arr.shape[1]
+        elif arr.shape[1] != n_channels:
+            raise ValueError(
+                f"{input_name}: clip {i} has {arr.shape[1]} channels, but clip 0 has "
+                f"{n_channels}; all clips of a collection share their channels."
+            )
+        arr = np.array(arr, dtype=target, order="C", copy=copy or None)
+        # A finite sum means every value is finite (one pass, no temporary array);
+        # a non-finite one may be an overflow of finite values, so look closer.
+        if not np.isfinite(np.add.reduce(arr, axis=None)):
+            if allow_nan:
+                if np.isinf(arr).any():
+                    raise ValueError(_describe_bad_value(np.where(np.isnan(arr), 0, arr), i, input_name))
+            elif not np.isfinite(arr).all():
+                raise ValueError(
+                    _describe_bad_value(arr, i, input_name)
+                    + f"; {name} does not accept missing values (fill gaps first)."
+                )
+        clips.append(arr)
+    return clips, n_channels
+
+
 def check_clips(
     X,
     *,
@@ -314,42 +358,8 @@ def check_clips(
             f"{input_name} holds {len(raw)} clip(s); {name} needs at least {min_clips}."
         )
 
-    clips = []
-    n_channels = None
-    for i, clip in enumerate(raw):
-        arr, target = _as_float_clip(clip, i, dtypes, input_name)
-        if arr.ndim != 2:
-            raise ValueError(
-                f"{input_name}: clip {i} is {arr.ndim}-D with shape {arr.shape}; "
-                "expected a 2-D array of shape (n_frames, n_channels)"
-                + (" (use clip.reshape(-1, 1) for one channel)." if arr.ndim == 1 else ".")
-            )
-        if arr.shape[0] == 0 and min_frames > 0:
-            raise ValueError(f"{input_name}: clip {i} has no frames.")
-        if arr.shape[1] == 0:
-            raise ValueError(f"{input_name}: clip {i} has no channels.")
-        if arr.shape[0] < min_frames:
-            raise ValueError(
-                f"{input_name}: clip {i} has {arr.shape[0]} frame(s); {name} needs "
-                f"at least {min_frames}."
-            )
-        if n_channels is None:
-            n_channels = arr.shape[1]
-        elif arr.shape[1] != n_channels:
-            raise ValueError(
-                f"{input_name}: clip {i} has {arr.shape[1]} channels, but clip 0 has "
-                f"{n_channels}; all clips of a collection share their channels."
-            )
-        arr = np.array(arr, dtype=target, order="C", copy=copy or None)
-        if allow_nan:
-            if np.isinf(arr).any():
-                raise ValueError(_describe_bad_value(np.where(np.isnan(arr), 0, arr), i, input_name))
-        elif not np.isfinite(arr).all():
-            raise ValueError(
-                _describe_bad_value(arr, i, input_name)
-                + f"; {name} does not accept missing values (fill gaps first)."
-            )
-        clips.append(arr)
+    with np.errstate(over="ignore", invalid="ignore"):  # the finite check sums the values, see below
+        clips, n_channels = _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name)
 
     if estimator is not None:
         if reset:

@@ -80,7 +80,7 @@ def test_the_compiled_decoder_agrees_for_every_covariance_and_table(monkeypatch,
         monkeypatch.setattr(_transitions, "_DENSE_LIMIT", 0)
     graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 45, 90],
                                     graph_of_clip=[0, 1], smoothing=0.5)
-    assert (len(graphs.kernel_table(1)[5]) > 0) == dense
+    assert (len(graphs.kernel_table(1)["dense"]) > 0) == dense
     clip = frames[[2, 33, 61, 80, 14]] + 0.3
     wide = int(tree.n_nodes.max())
     for graph in (0, 1):
@@ -312,3 +312,26 @@ def test_score_layers_stop_at_layer_one(model):
     assert scores.shape == (1, 2, 2)  # layers 1 and 2
     with pytest.raises(ValueError, match="score_layers must be an int >= 1"):
         beam_decode(tree, graphs, frames[:6], [0, 6], [0], [0], layer=2, score_layers=0)
+
+
+def test_low_rank_covariances_decode_as_the_full_factor():
+    """Nodes with fewer frames than channels take the compiled O(r d) form; the reference uses Cholesky."""
+    rng = np.random.default_rng(11)
+    d = 48
+    frames = np.vstack([rng.normal(c, 1.0, size=(24, d)) for c in (0.0, 2.0, 4.0)])
+    tree = MotionTree.build(frames, max_depth=3, min_samples_leaf=4, split="median", covariance_type="full")
+    low = tree.kernel_gaussians()["lr_start"] >= 0
+    assert low.any() and not low.all()  # both forms are exercised
+    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 36, 72],
+                                    graph_of_clip=[0, 1], smoothing=0.5)
+    clip = frames[[2, 30, 50, 70, 5]] + rng.normal(scale=0.3, size=(5, d))
+    wide = int(tree.n_nodes.max())
+    for graph in (0, 1):
+        paths, scores = beam_decode(tree, graphs, clip, [0, 5], [0], [graph], layer=-1, n_paths=wide,
+                                    score_layers=tree.n_layers, node_prior="layer")
+        for row, layer in enumerate(range(1, tree.n_layers)):
+            ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
+                                                     node_prior="layer")
+            np.testing.assert_allclose(scores[0, row], ex_scores, rtol=1e-10, atol=1e-8)
+        finite = np.isfinite(ex_scores)
+        np.testing.assert_array_equal(paths[0][finite], ex_paths[finite])

@@ -5,7 +5,9 @@ import pytest
 from scipy.stats import multivariate_normal
 from sklearn.covariance import ledoit_wolf, ledoit_wolf_shrinkage as sk_shrinkage
 
-from skmotion.tree._gaussian import Gaussians, centred_moments, estimate_covariance, ledoit_wolf_shrinkage
+from skmotion.tree._gaussian import (
+    Gaussians, centred_moments, estimate_covariance, ledoit_wolf_shrinkage, low_rank_covariance,
+)
 
 
 @pytest.mark.parametrize("chunk_rows", [None, 7])
@@ -70,3 +72,17 @@ def test_log_pdf_matches_scipy(kind):
 def test_unknown_kind():
     with pytest.raises(ValueError, match="covariance_type must be one of"):
         estimate_covariance(np.zeros((2, 2)), np.zeros(2), "tied", 0.0)
+
+
+@pytest.mark.parametrize("n, d", [(1, 6), (2, 6), (5, 20), (12, 192), (20, 20)])
+def test_the_low_rank_form_is_the_full_estimate(n, d):
+    """floor I + V^T diag(values) V is the Ledoit-Wolf estimate (sklearn's), and V has the frames' rank."""
+    X = np.random.default_rng(d + n).normal(size=(n, d)) @ np.diag(np.linspace(0.1, 3, d)) + 5.0
+    mean, scatter, sq_norms = centred_moments(X)
+    floor, vectors, values = low_rank_covariance(X - mean, scatter, sq_norms, 1e-3)
+    assert len(vectors) == min(n - 1, d)
+    np.testing.assert_allclose(vectors @ vectors.T, np.eye(len(vectors)), atol=1e-12)
+    rebuilt = floor * np.eye(d) + vectors.T @ np.diag(values) @ vectors
+    expected = ledoit_wolf(X - mean, assume_centered=True)[0] + 1e-3 * np.eye(d) if n > 1 else 1e-3 * np.eye(d)
+    np.testing.assert_allclose(rebuilt, expected, atol=1e-12)
+    np.testing.assert_allclose(rebuilt, estimate_covariance(scatter, sq_norms, "full", 1e-3), atol=1e-12)

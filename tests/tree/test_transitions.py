@@ -97,17 +97,27 @@ def test_smoothing_must_be_positive():
 
 
 def test_the_kernel_table_holds_every_log_probability(monkeypatch, rng):
-    """The compiled decoder's lookups (dense table, or sorted rows and unseen mass) give log_prob exactly."""
+    """The compiled decoder's lookups (dense table, or a pair's row of every graph and the unseen rows) give
+    log_prob exactly."""
     dense, sparse = dense_and_sparse(monkeypatch, rng.integers(0, 6, size=150), 6, offsets=[0, 40, 90, 150],
                                      graph_of_clip=[0, 1, 2], smoothing=0.7)
     for graphs, has_dense in ((dense, True), (sparse, False)):
-        indptr, indices, seen, unseen, k, table, n_graphs = graphs.kernel_table(0)
-        assert (k, n_graphs, len(table) > 0) == (6, 3, has_dense)
+        table = graphs.kernel_table(0)
+        k, n_graphs = table["k"], table["n_graphs"]
+        assert (k, n_graphs, len(table["dense"]) > 0) == (6, 3, has_dense)
+        assert np.isneginf(table["unseen_log"][k]).all()  # "no node"
         for g, src, dst in itertools.product(range(3), range(6), range(6)):
             expected = dense.log_prob(0, g, src, dst)
-            row = g * k + src
-            stored = indices[indptr[row] : indptr[row + 1]]
-            looked_up = seen[indptr[row] + np.flatnonzero(stored == dst)[0]] if dst in stored else unseen[row]
+            start, stop = table["pair_start"][src], table["pair_start"][src + 1]
+            stored = table["pair_dst"][start:stop]
+            assert (np.diff(stored) > 0).all()
+            if dst in stored:
+                looked_up = table["pair_log"][start + np.flatnonzero(stored == dst)[0], g]
+            else:
+                looked_up = table["unseen_log"][src, g]
             assert looked_up == expected
             if has_dense:
-                assert table[(src * (k + 1) + dst) * n_graphs + g] == expected
+                assert table["dense"][(src * (k + 1) + dst) * n_graphs + g] == expected
+        # a pair is stored when any graph made that transition
+        made = sum(graphs.counts(0, g).toarray() for g in range(3)) > 0
+        assert len(table["pair_dst"]) == made.sum()
