@@ -251,7 +251,7 @@ class Gaussians:
             ``means`` ``(n, d)``; ``prec``: flat per-channel precisions (``"diag"``
             and ``"spherical"``, the latter repeated over channels) or flat upper
             triangular factors ``U`` with ``U U^T`` the precision (``"full"``);
-            ``shifts`` ``(n, d)``, ``mean @ U`` (a ``(1, 1)`` placeholder otherwise);
+            ``shifts`` ``(n, d)``, ``mean @ U`` (for the other kinds an unused ``(1, 1)`` array);
             ``const`` ``(n,)``; ``full``. For the Gaussians of ``"full"`` taken
             in low-rank form (``floor I + V^T diag(values) V``), ``lr_start[k]``
             is the first row of ``lr_vectors`` ``(R, d)`` of Gaussian ``k`` and

@@ -27,9 +27,9 @@ __all__ = ["TransitionGraphs"]
 # Graphs whose dense table (n_graphs * K * K) is at most this many entries keep
 # one, so lookups are one gather instead of a binary search.
 _DENSE_LIMIT = 1 << 21
-# The compiled decoder reads a dense table up to 8 MB; beyond, a cache miss per
-# lookup costs more than the short search in a node's row of seen transitions
-# (measured on JapaneseVowels' trees: 256 KB and 2 MB limits were slower).
+# The compiled decoder reads a dense table up to 8 MB, and beyond it searches the
+# short row of transitions seen from a node. On JapaneseVowels' trees a 256 KB
+# limit was slower (more searches); limits from 2 MB to 64 MB timed alike.
 _KERNEL_DENSE_LIMIT = 1 << 20
 
 
@@ -166,8 +166,8 @@ class TransitionGraphs:
             (a graph that never made one has its unseen value there);
             ``unseen_log`` ``(K + 1, n_graphs)``: a never-seen transition from
             each node, and ``-inf`` in row ``K`` ("no node"); ``dense``: the
-            flat ``(K + 1, K + 1, n_graphs)`` table of them all where it is small
-            enough to stay in a processor cache (a lookup without a search), else empty.
+            flat ``(K + 1, K + 1, n_graphs)`` table of them all where it is at most
+            8 MB (a lookup without a search), else empty.
         """
         return self._kernel[layer]
 
@@ -189,7 +189,7 @@ class TransitionGraphs:
             "n_graphs": n_graphs,
             "pair_start": np.searchsorted(pair_src, np.arange(k + 1)).astype(np.intp),
             "pair_dst": pair_dst.astype(np.intp),
-            "pair_log": pair_log.reshape(-1, n_graphs),
+            "pair_log": pair_log,
             "unseen_log": np.ascontiguousarray(np.vstack([unseen.T, np.full((1, n_graphs), -np.inf)])),
             "dense": self._dense[layer] if small else np.zeros(0),
         }

@@ -220,10 +220,11 @@ def test_the_fitted_marker_pipeline_pickles(marker_search):
     np.testing.assert_array_equal(restored.score_samples(data.clips), search.best_estimator_.score_samples(data.clips))
 
 
+@pytest.mark.parametrize("n_paths", [1, 3])  # 1: predict takes the best-score pass alone
 @pytest.mark.parametrize("graph", ["class", "clip"])
-def test_pruned_predict_agrees_with_full_scoring(motions, graph):
+def test_pruned_predict_agrees_with_full_scoring(motions, graph, n_paths):
     X, y, _ = motions
-    model = MotionTreeHMM(max_depth=4, n_paths=3, graph=graph).fit(X[::2], y[::2])
+    model = MotionTreeHMM(max_depth=4, n_paths=n_paths, graph=graph).fit(X[::2], y[::2])
     np.testing.assert_array_equal(model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)])
 
 
