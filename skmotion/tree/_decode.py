@@ -138,14 +138,15 @@ def exhaustive_viterbi(tree, graphs, layer, frames, graph=0, *, n_paths=1, node_
     return paths[0], scores[0]
 
 
+# The compiled decoder's mask for "every node allowed".
+_ALL_NODES = np.zeros((0, 0), dtype=np.uint8)
+
+
 def _kernel_allowed(graphs, layer, node_prior):
     """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``, or ``(0, 0)`` for every node."""
     if node_prior == "layer":
         return _ALL_NODES
     return np.ascontiguousarray(_allowed_nodes(graphs, layer, node_prior), dtype=np.uint8)
-
-
-_ALL_NODES = np.zeros((0, 0), dtype=np.uint8)
 
 
 def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
