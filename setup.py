@@ -4,6 +4,10 @@ from Cython.Build import cythonize
 from setuptools import Extension, setup
 
 # -fopenmp-simd honours the `omp simd` pragmas of _emission.h (vectorised sums) without linking OpenMP.
-beam = Extension("skmotion.tree._beam", ["skmotion/tree/_beam.pyx"], depends=["skmotion/tree/_emission.h"],
-                 extra_compile_args=["-O3", "-fopenmp-simd"])
+beam = Extension(
+    "skmotion.tree._beam",
+    ["skmotion/tree/_beam.pyx"],
+    depends=["skmotion/tree/_emission.h"],
+    extra_compile_args=["-O3", "-fopenmp-simd"],
+)
 setup(ext_modules=cythonize([beam]))

@@ -51,7 +51,12 @@ def write_results(name, rows, *, notes=""):
         writer = csv.DictWriter(fh, fieldnames=columns)
         writer.writeheader()
         writer.writerows(rows)
-    lines = [f"# {name}", "", f"machine: {platform.platform()}, Python {platform.python_version()}", ""]
+    lines = [
+        f"# {name}",
+        "",
+        f"machine: {platform.platform()}, Python {platform.python_version()}",
+        "",
+    ]
     if notes:
         lines += [notes, ""]
     lines += ["| " + " | ".join(columns) + " |", "|" + "---|" * len(columns)]

@@ -1,8 +1,8 @@
 """Data sets shared by the neighbors benchmarks (nothing here is timed)."""
 
 import numpy as np
-
 from _common import SHARED_DATA
+
 from skmotion.datasets import load_cmu_asfamc, load_uea, make_repeated_motions
 from skmotion.preprocessing import to_markers
 
@@ -56,7 +56,9 @@ def cmu_repeats():
     return {
         "CMU repeats, joint angles": by_trial(angles, data.trials),
         "CMU repeats, virtual markers": by_trial(markers, data.trials),
-        "CMU repeats, joint angles, one-activity trials": by_trial([angles[k] for k in steady], data.trials[steady]),
+        "CMU repeats, joint angles, one-activity trials": by_trial(
+            [angles[k] for k in steady], data.trials[steady]
+        ),
     }
 
 

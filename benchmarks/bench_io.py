@@ -53,7 +53,11 @@ def bench_bvh(files, repeats):
     for path in files:
         megabytes = path.stat().st_size / 1e6
         ours = read_bvh(path)
-        degrees = np.where([c.endswith("rotation") for c in ours.channel_names], np.rad2deg(ours.channels), ours.channels)
+        degrees = np.where(
+            [c.endswith("rotation") for c in ours.channel_names],
+            np.rad2deg(ours.channels),
+            ours.channels,
+        )
         np.testing.assert_allclose(degrees, peer_bvh(path), atol=1e-9)  # the same numbers
         fast, bvh_time, bvhio_time = interleaved(
             [lambda: read_bvh(path), lambda: peer_bvh(path), lambda: peer_bvhio(path)], repeats
@@ -80,7 +84,9 @@ def bench_amc(files, repeats):
         skeleton = read_asf(path.with_name(f"{path.stem.split('_')[0]}.asf"))
         motion = read_amc(path, skeleton)
         assert len(line_by_line_amc(path)) == motion.n_frames
-        fast, slow = interleaved([lambda: read_amc(path, skeleton), lambda: line_by_line_amc(path)], repeats)
+        fast, slow = interleaved(
+            [lambda: read_amc(path, skeleton), lambda: line_by_line_amc(path)], repeats
+        )
         rows.append(
             {
                 "file": f"{path.parent.name}/{path.name}",

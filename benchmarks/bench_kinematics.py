@@ -45,11 +45,15 @@ def main():
     for n_frames in (100, 1_000, 10_000):
         channels = rng.uniform(-1, 1, size=(n_frames, skeleton.n_channels))
         np.testing.assert_allclose(
-            forward_kinematics(skeleton, channels[:50]).positions, per_frame_fk(skeleton, channels[:50]), atol=1e-10
+            forward_kinematics(skeleton, channels[:50]).positions,
+            per_frame_fk(skeleton, channels[:50]),
+            atol=1e-10,
         )
         fast, _ = time_call(lambda: forward_kinematics(skeleton, channels), repeats=5)
         loop_frames = min(n_frames, 1_000)
-        slow, _ = time_call(lambda: per_frame_fk(skeleton, channels[:loop_frames]), repeats=1, warmup=0)
+        slow, _ = time_call(
+            lambda: per_frame_fk(skeleton, channels[:loop_frames]), repeats=1, warmup=0
+        )
         slow *= n_frames / loop_frames
         rows.append(
             {

@@ -77,7 +77,12 @@ def worker(operation, n_frames, folder):
         else:
             from hmmlearn.hmm import GaussianHMM
 
-            peer = GaussianHMM(len(model.tree_.node_ids(model.layer_)), covariance_type="diag", n_iter=5, random_state=0)
+            peer = GaussianHMM(
+                len(model.tree_.node_ids(model.layer_)),
+                covariance_type="diag",
+                n_iter=5,
+                random_state=0,
+            )
             peer.fit(base)
             (log_lik, _), seconds, extra = _measure(lambda: peer.decode(clip))
             out["finite"] = bool(np.isfinite(log_lik))
@@ -99,7 +104,9 @@ def worker(operation, n_frames, folder):
             channels = motion.channels
         assert channels.shape[0] == n_frames
         out["finite"] = bool(np.isfinite(channels).all())
-        out["file_bytes"] = (folder / ("long.amc" if operation == "read_amc" else "long.bvh")).stat().st_size
+        out["file_bytes"] = (
+            (folder / ("long.amc" if operation == "read_amc" else "long.bvh")).stat().st_size
+        )
         input_bytes = channels.nbytes
     out.update(seconds=seconds, extra_bytes=extra, input_bytes=input_bytes)
     print(json.dumps(out))
@@ -139,7 +146,9 @@ def main(hmm_sizes, reader_sizes):
     rows = []
     for n in hmm_sizes:
         peer = run("hmmlearn_decode", n, "")
-        rows.append(_row("MotionTreeHMM.decode", n, run("hmm_decode", n, ""), ("hmmlearn decode", peer)))
+        rows.append(
+            _row("MotionTreeHMM.decode", n, run("hmm_decode", n, ""), ("hmmlearn decode", peer))
+        )
         rows.append(_row("MotionTreeHMM.score_samples", n, run("hmm_score_samples", n, "")))
         rows.append(_row("hmmlearn GaussianHMM.decode", n, peer))
         print(rows[-3:], flush=True)

@@ -35,7 +35,10 @@ def leaf_entries(features, labels, n_levels, epsilon, max_entries=64):
     """How many (leaf, clip) pairs the tree would hold, without building it."""
     tree = features[:, :n_levels]
     radius = epsilon * learn_delta(tree, np.unique(labels, return_inverse=True)[1], 1.0)
-    edges = [entry_edges(tree[:, i].min(), tree[:, i].max(), radius[i], max_entries) for i in range(n_levels)]
+    edges = [
+        entry_edges(tree[:, i].min(), tree[:, i].max(), radius[i], max_entries)
+        for i in range(n_levels)
+    ]
     first, last = IntervalIndex(edges, radius).covering_entries(tree)
     return float(np.prod((last - first + 1).astype(float), axis=1).sum())
 
@@ -79,11 +82,26 @@ def main():
             for n_levels in (lv for lv in LEVELS if lv <= r):
                 for epsilon in EPSILONS:
                     pairs = leaf_entries(features, labels, n_levels, epsilon)
-                    row = {"dataset": name, "clips": len(clips), "features": weighting, "n_levels": n_levels, "epsilon": epsilon}
+                    row = {
+                        "dataset": name,
+                        "clips": len(clips),
+                        "features": weighting,
+                        "n_levels": n_levels,
+                        "epsilon": epsilon,
+                    }
                     if pairs > MAX_PAIRS:
-                        rows.append({**row, "pruning": float("nan"), "recall": float("nan"), "leaves_per_clip": pairs / len(clips)})
+                        rows.append(
+                            {
+                                **row,
+                                "pruning": float("nan"),
+                                "recall": float("nan"),
+                                "leaves_per_clip": pairs / len(clips),
+                            }
+                        )
                         continue
-                    index = IntervalIndexNeighbors(n_levels=n_levels, epsilon=epsilon).fit(features, labels)
+                    index = IntervalIndexNeighbors(n_levels=n_levels, epsilon=epsilon).fit(
+                        features, labels
+                    )
                     found = index.candidates()
                     rows.append(
                         {
@@ -101,8 +119,12 @@ def main():
         f"returned / similar clips (similar = same label). Trees over {MAX_PAIRS:,} leaf entries are not built (nan).",
     )
     summary = []
-    for (name, weighting) in sorted({(r["dataset"], r["features"]) for r in rows}):
-        mine = [r for r in rows if r["dataset"] == name and r["features"] == weighting and r["recall"] == r["recall"]]
+    for name, weighting in sorted({(r["dataset"], r["features"]) for r in rows}):
+        mine = [
+            r
+            for r in rows
+            if r["dataset"] == name and r["features"] == weighting and r["recall"] == r["recall"]
+        ]
         for bound in (0.99, 1.0):
             ok = [r for r in mine if r["recall"] >= bound - 1e-12]
             best = max(ok, key=lambda r: r["pruning"]) if ok else None
@@ -136,7 +158,11 @@ def main():
         "of component i: the maximum over the labels = the paper's rule, or a quantile) over the component's range, "
         "averaged over the components; widest_labels: the labels with the largest mean relative range.",
     )
-    write_results("neighbors_pruning_summary", summary, notes="Best pruning over the grid at a recall bound; the paper reports ~90% (body) to 95% (hand) at ~100% recall with eps 0.8-1.0, 7 levels.")
+    write_results(
+        "neighbors_pruning_summary",
+        summary,
+        notes="Best pruning over the grid at a recall bound; the paper reports ~90% (body) to 95% (hand) at ~100% recall with eps 0.8-1.0, 7 levels.",
+    )
     try:
         from skmotion.plotting import plot_pruning_recall
     except ImportError:
@@ -158,7 +184,9 @@ def quantile_sweep():
         features = SVDFeatureExtractor(n_components=7, weighting="first_two").fit_transform(clips)
         for quantile in (0.5, 0.75, 0.9, 1.0):
             for epsilon in (0.8, 1.0, 1.2, 1.5):
-                index = IntervalIndexNeighbors(n_levels=7, epsilon=epsilon, delta_quantile=quantile).fit(features, labels)
+                index = IntervalIndexNeighbors(
+                    n_levels=7, epsilon=epsilon, delta_quantile=quantile
+                ).fit(features, labels)
                 found = index.candidates()
                 rows.append(
                     {

@@ -39,19 +39,50 @@ def traversal_rows(index, features, n):
     batched, _ = time_call(lambda: index.index_.leaf_of(tree), repeats=5)
     singles = tree[:200]
     one, _ = time_call(lambda: [index.index_.leaf_of(q[None]) for q in singles], repeats=3)
-    one_numpy, _ = time_call(lambda: [index.index_._leaf_of_batch(q[None]) for q in singles], repeats=3)
+    one_numpy, _ = time_call(
+        lambda: [index.index_._leaf_of_batch(q[None]) for q in singles], repeats=3
+    )
     rows = [
-        {"collection": n, "what": "traversal, batched", "method": "IntervalIndex.leaf_of", "us_per_query": 1e6 * batched / len(tree)},
-        {"collection": n, "what": "traversal, one at a time", "method": "IntervalIndex.leaf_of (bisect path)", "us_per_query": 1e6 * one / len(singles)},
-        {"collection": n, "what": "traversal, one at a time", "method": "vectorised path on 1 query", "us_per_query": 1e6 * one_numpy / len(singles)},
+        {
+            "collection": n,
+            "what": "traversal, batched",
+            "method": "IntervalIndex.leaf_of",
+            "us_per_query": 1e6 * batched / len(tree),
+        },
+        {
+            "collection": n,
+            "what": "traversal, one at a time",
+            "method": "IntervalIndex.leaf_of (bisect path)",
+            "us_per_query": 1e6 * one / len(singles),
+        },
+        {
+            "collection": n,
+            "what": "traversal, one at a time",
+            "method": "vectorised path on 1 query",
+            "us_per_query": 1e6 * one_numpy / len(singles),
+        },
     ]
     stored = index._tree_features
     for algorithm in ("brute", "kd_tree"):
         nn = NearestNeighbors(n_neighbors=1, algorithm=algorithm).fit(stored)
         seconds, _ = time_call(lambda: nn.kneighbors(tree), repeats=3)
         one, _ = time_call(lambda: [nn.kneighbors(q[None]) for q in singles[:50]], repeats=1)
-        rows.append({"collection": n, "what": "1-NN on the feature vectors, batched", "method": f"sklearn {algorithm}", "us_per_query": 1e6 * seconds / len(tree)})
-        rows.append({"collection": n, "what": "1-NN on the feature vectors, one at a time", "method": f"sklearn {algorithm}", "us_per_query": 1e6 * one / 50})
+        rows.append(
+            {
+                "collection": n,
+                "what": "1-NN on the feature vectors, batched",
+                "method": f"sklearn {algorithm}",
+                "us_per_query": 1e6 * seconds / len(tree),
+            }
+        )
+        rows.append(
+            {
+                "collection": n,
+                "what": "1-NN on the feature vectors, one at a time",
+                "method": f"sklearn {algorithm}",
+                "us_per_query": 1e6 * one / 50,
+            }
+        )
     return rows
 
 
@@ -63,7 +94,9 @@ def end_to_end_rows(index, db_clips, db_labels, queries, query_labels, n):
 
     # sklearn's precomputed search wants the square training matrix at fit; its
     # values play no part in kneighbors, so zeros do (setup, not timed).
-    precomputed = NearestNeighbors(n_neighbors=1, metric="precomputed").fit(np.zeros((n, n), dtype=np.float32))
+    precomputed = NearestNeighbors(n_neighbors=1, metric="precomputed").fit(
+        np.zeros((n, n), dtype=np.float32)
+    )
 
     def brute_psi():
         signatures = psi_signatures(queries, index.k)
@@ -77,7 +110,9 @@ def end_to_end_rows(index, db_clips, db_labels, queries, query_labels, n):
         return precomputed.kneighbors(distance, return_distance=False)[:, 0]
 
     extractor = index.feature_extractor_
-    features_nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(extractor.transform(db_clips))
+    features_nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(
+        extractor.transform(db_clips)
+    )
 
     def brute_features():
         return features_nn.kneighbors(extractor.transform(queries), return_distance=False)[:, 0]
@@ -120,13 +155,24 @@ def dtw_rows(clips, labels, queries, query_labels, n=300, n_queries=30, extrapol
     except ImportError:
         print('tslearn is not installed (pip install "skmotion[bench]"): no DTW comparison')
         return []
-    db, db_labels, q, q_labels = clips[:n], labels[:n], queries[:n_queries], query_labels[:n_queries]
+    db, db_labels, q, q_labels = (
+        clips[:n],
+        labels[:n],
+        queries[:n_queries],
+        query_labels[:n_queries],
+    )
     index = IntervalIndexNeighbors(**PARAMS).fit(db, db_labels)
     dtw = KNeighborsTimeSeries(n_neighbors=1, metric="dtw").fit(to_time_series_dataset(db))
     dtw.kneighbors(to_time_series_dataset(q[:1]))  # compiles tslearn's numba code (not timed)
     methods = (
-        ("IntervalIndexNeighbors", lambda: index.kneighbors(q, n_neighbors=1, return_distance=False)[:, 0]),
-        ("tslearn 1-NN DTW", lambda: dtw.kneighbors(to_time_series_dataset(q), return_distance=False)[:, 0]),
+        (
+            "IntervalIndexNeighbors",
+            lambda: index.kneighbors(q, n_neighbors=1, return_distance=False)[:, 0],
+        ),
+        (
+            "tslearn 1-NN DTW",
+            lambda: dtw.kneighbors(to_time_series_dataset(q), return_distance=False)[:, 0],
+        ),
     )
     rows = []
     for method, func in methods:
@@ -146,8 +192,15 @@ def dtw_rows(clips, labels, queries, query_labels, n=300, n_queries=30, extrapol
         )
         print(rows[-1], flush=True)
     dtw_us = rows[-1]["us_per_query"]
-    rows.append({**rows[-1], "collection": extrapolate_to, "what": f"extrapolated from {n} clips (linear)",
-                 "us_per_query": dtw_us * extrapolate_to / n, "same_motion": float("nan")})
+    rows.append(
+        {
+            **rows[-1],
+            "collection": extrapolate_to,
+            "what": f"extrapolated from {n} clips (linear)",
+            "us_per_query": dtw_us * extrapolate_to / n,
+            "same_motion": float("nan"),
+        }
+    )
     return rows
 
 
@@ -161,14 +214,24 @@ def main():
         index = IntervalIndexNeighbors(**PARAMS).fit(db, db_labels)
         print(f"{n} clips: fit {time.perf_counter() - start:.1f} s", flush=True)
         features = index.feature_extractor_.transform(queries)
-        rows += traversal_rows(index, np.vstack([index._tree_features, features[:, : index.n_levels]]), n)
+        rows += traversal_rows(
+            index, np.vstack([index._tree_features, features[:, : index.n_levels]]), n
+        )
         part = end_to_end_rows(index, db, db_labels, queries, query_labels, n)
         end_rows += part
         for r in rows[-7:] + part:
             print(r, flush=True)
     end_rows += dtw_rows(clips, labels, queries, query_labels)
-    write_results("neighbors_traversal", rows, notes="Microseconds per query to reach the leaf (7 levels, epsilon 0.8) vs sklearn 1-NN on the same 7-D feature vectors.")
-    write_results("neighbors_end_to_end", end_rows, notes=f"{N_QUERIES} held-out clips query collections of 2-4 s synthetic clips (75 channels); same_motion = the 1-NN is a clip of the query's motion.")
+    write_results(
+        "neighbors_traversal",
+        rows,
+        notes="Microseconds per query to reach the leaf (7 levels, epsilon 0.8) vs sklearn 1-NN on the same 7-D feature vectors.",
+    )
+    write_results(
+        "neighbors_end_to_end",
+        end_rows,
+        notes=f"{N_QUERIES} held-out clips query collections of 2-4 s synthetic clips (75 channels); same_motion = the 1-NN is a clip of the query's motion.",
+    )
 
 
 if __name__ == "__main__":

@@ -84,7 +84,14 @@ def main(sizes=SIZES):
     sizes = np.log([r["clips"] for r in rows])
     slopes = {
         key: float(np.polyfit(sizes, np.log([r[key] for r in rows]), 1)[0])
-        for key in ("fit_s", "fit_cpu_s", "tree_build_s", "tree_MB", "signatures_MB", "insert_cpu_ms_median")
+        for key in (
+            "fit_s",
+            "fit_cpu_s",
+            "tree_build_s",
+            "tree_MB",
+            "signatures_MB",
+            "insert_cpu_ms_median",
+        )
     }
     notes = (
         f"{PARAMS['n_levels']} levels, epsilon {PARAMS['epsilon']}. Growth exponents (log-log slope over the sizes): "

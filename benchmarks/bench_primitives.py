@@ -42,7 +42,9 @@ RULES = {"SEG-1 (zvc)": "zvc", "SEG-2 (energy)": "energy"}
 def right_arm_degrees(n_clips_per_class, random_state=0):
     data = make_motions(n_clips_per_class=n_clips_per_class, random_state=random_state)
     sk = data.skeleton
-    arm = ArmModel.from_skeleton(sk, ["RightArm", "RightForeArm"], dofs=["ZXY", "X"], end="RightHand_end")
+    arm = ArmModel.from_skeleton(
+        sk, ["RightArm", "RightForeArm"], dofs=["ZXY", "X"], end="RightHand_end"
+    )
     idx = [sk.channel_names.index(n) for n in arm.dof_names]
     return data, arm, [np.degrees(c[:, idx]) for c in data.clips]
 
@@ -56,8 +58,15 @@ def cmu_right_arm_degrees():
     clips = []
     for motion in data.motions:
         names = motion.channel_names
-        idx = [names.index(n) for n in ("rhumerus_Xrotation", "rhumerus_Yrotation", "rhumerus_Zrotation",
-                                        "rradius_Xrotation")]
+        idx = [
+            names.index(n)
+            for n in (
+                "rhumerus_Xrotation",
+                "rhumerus_Yrotation",
+                "rhumerus_Zrotation",
+                "rradius_Xrotation",
+            )
+        ]
         clips.append(np.degrees(np.unwrap(motion.channels[:, idx], axis=0)))
     return data, clips
 
@@ -65,7 +74,9 @@ def cmu_right_arm_degrees():
 def cut_segments(clips, rule, frame_rate):
     pieces = []
     for clip in clips:
-        for start, stop in segment_clip(clip, rule=rule, frame_rate=frame_rate, min_movement=MIN_MOVEMENT):
+        for start, stop in segment_clip(
+            clip, rule=rule, frame_rate=frame_rate, min_movement=MIN_MOVEMENT
+        ):
             pieces.append(clip[start:stop])
     return pieces
 
@@ -95,12 +106,18 @@ def error_tables(clips, frame_rate):
         for k in (10, 20, 30, 40):
             pca = EigenMovementPCA(k, n_samples=N_SAMPLES, segmentation="none").fit(train)
             test_rms = per_segment_rms(pca, test, pca.transform(test))
-            rows.append({
-                "table": "1 projection", "segmentation": name, "n_segments (train/test)": f"{len(train)}/{len(test)}",
-                "eigenvectors": k, "clusters": "-", "MSE (deg^2 per segment)": pca.projection_mse_,
-                "RMS train (deg)": np.sqrt(pca.projection_mse_ / n_features),
-                "RMS test (deg)": float(np.sqrt(np.mean(test_rms**2))),
-            })
+            rows.append(
+                {
+                    "table": "1 projection",
+                    "segmentation": name,
+                    "n_segments (train/test)": f"{len(train)}/{len(test)}",
+                    "eigenvectors": k,
+                    "clusters": "-",
+                    "MSE (deg^2 per segment)": pca.projection_mse_,
+                    "RMS train (deg)": np.sqrt(pca.projection_mse_ / n_features),
+                    "RMS test (deg)": float(np.sqrt(np.mean(test_rms**2))),
+                }
+            )
         pca = EigenMovementPCA(30, n_samples=N_SAMPLES, segmentation="none").fit(train)
         train_codes, test_codes = pca.transform(train), pca.transform(test)
         for n_clusters in (10, 20, 30, 100):
@@ -110,14 +127,19 @@ def error_tables(clips, frame_rate):
             test_rms = per_segment_rms(pca, test, controller.quantize(test_codes))
             measured = float(np.mean(train_rms**2) * n_features)
             assert np.isclose(measured, total, rtol=1e-8), (measured, total)
-            rows.append({
-                "table": "2-3 clustering, total", "segmentation": name,
-                "n_segments (train/test)": f"{len(train)}/{len(test)}", "eigenvectors": 30,
-                "clusters": n_clusters, "MSE (deg^2 per segment)": controller.clustering_mse_,
-                "RMS train (deg)": float(np.sqrt(total / n_features)),
-                "RMS test (deg)": float(np.sqrt(np.mean(test_rms**2))),
-                "median RMS train/test (deg)": f"{np.median(train_rms):.2f}/{np.median(test_rms):.2f}",
-            })
+            rows.append(
+                {
+                    "table": "2-3 clustering, total",
+                    "segmentation": name,
+                    "n_segments (train/test)": f"{len(train)}/{len(test)}",
+                    "eigenvectors": 30,
+                    "clusters": n_clusters,
+                    "MSE (deg^2 per segment)": controller.clustering_mse_,
+                    "RMS train (deg)": float(np.sqrt(total / n_features)),
+                    "RMS test (deg)": float(np.sqrt(np.mean(test_rms**2))),
+                    "median RMS train/test (deg)": f"{np.median(train_rms):.2f}/{np.median(test_rms):.2f}",
+                }
+            )
     for row in rows:
         row.setdefault("median RMS train/test (deg)", "-")
     return rows
@@ -133,7 +155,9 @@ def fit_times(clips, frame_rate):
         seed = KMeansPrimitiveController(30, random_state=0).fit(codes).kmeans_.random_state
 
         def skmotion_fit():
-            codes = EigenMovementPCA(30, frame_rate=frame_rate, min_movement=MIN_MOVEMENT).fit_transform(subset)
+            codes = EigenMovementPCA(
+                30, frame_rate=frame_rate, min_movement=MIN_MOVEMENT
+            ).fit_transform(subset)
             KMeansPrimitiveController(30, n_init=10, random_state=0).fit(codes)
 
         def sklearn_fit():  # the same K-means start as the controller's
@@ -145,17 +169,26 @@ def fit_times(clips, frame_rate):
                 skmotion_fit,
                 sklearn_fit,
                 lambda: pca.segment_vectors(subset),
-                lambda: EigenMovementPCA(30, frame_rate=frame_rate, min_movement=MIN_MOVEMENT).fit(subset),
+                lambda: EigenMovementPCA(30, frame_rate=frame_rate, min_movement=MIN_MOVEMENT).fit(
+                    subset
+                ),
                 lambda: PCA(30, svd_solver="full").fit(vectors),
             ],
             rounds=7,
         )
-        rows.append({
-            "clips": n_clips, "segments": len(vectors), "frames": sum(len(c) for c in subset),
-            "skmotion_fit_ms": 1e3 * ours, "sklearn_PCA+KMeans_ms": 1e3 * theirs, "ratio": ours / theirs,
-            "EigenMovementPCA.fit_ms": 1e3 * eigen, "sklearn_PCA.fit_ms": 1e3 * plain,
-            "filter+segment+resample_ms": 1e3 * prep,
-        })
+        rows.append(
+            {
+                "clips": n_clips,
+                "segments": len(vectors),
+                "frames": sum(len(c) for c in subset),
+                "skmotion_fit_ms": 1e3 * ours,
+                "sklearn_PCA+KMeans_ms": 1e3 * theirs,
+                "ratio": ours / theirs,
+                "EigenMovementPCA.fit_ms": 1e3 * eigen,
+                "sklearn_PCA.fit_ms": 1e3 * plain,
+                "filter+segment+resample_ms": 1e3 * prep,
+            }
+        )
     return rows
 
 
@@ -167,21 +200,34 @@ def arm_tracking(data, arm, clips):
     seconds = sum(len(clips[i]) for i in chosen) / data.frame_rate
     rows = []
     for kp in (25.0, 100.0, 400.0, 1600.0):
+
         def run(kp=kp):
             return controller.simulate(
-                [codes[i] for i in chosen], [segments[i] for i in chosen], eigenmovements=pca, arm=arm,
-                frame_rate=data.frame_rate, degrees=True, kp=kp, kd=kp / 10,
+                [codes[i] for i in chosen],
+                [segments[i] for i in chosen],
+                eigenmovements=pca,
+                arm=arm,
+                frame_rate=data.frame_rate,
+                degrees=True,
+                kp=kp,
+                kd=kp / 10,
             )
+
         elapsed, _ = time_call(run, repeats=1, warmup=0)
         sims = run()
         errors = np.concatenate([(s.angles - s.desired).ravel() for s in sims])
         worst = max(np.nanmax(np.abs(s.torques)) for s in sims)
-        rows.append({
-            "kp (N m/rad)": kp, "kd (N m s/rad)": kp / 10,
-            "RMS tracking error (deg)": float(np.degrees(np.sqrt(np.nanmean(errors**2)))),
-            "peak torque (N m)": float(worst),
-            "simulated s": seconds, "wall s": elapsed, "x real time": seconds / elapsed,
-        })
+        rows.append(
+            {
+                "kp (N m/rad)": kp,
+                "kd (N m s/rad)": kp / 10,
+                "RMS tracking error (deg)": float(np.degrees(np.sqrt(np.nanmean(errors**2)))),
+                "peak torque (N m)": float(worst),
+                "simulated s": seconds,
+                "wall s": elapsed,
+                "x real time": seconds / elapsed,
+            }
+        )
     return rows
 
 

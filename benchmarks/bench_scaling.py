@@ -33,9 +33,8 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA, write_results  # noqa: E402
-
 import joblib  # noqa: E402
+from _common import SHARED_DATA, write_results  # noqa: E402
 from sklearn.base import clone  # noqa: E402
 from sklearn.model_selection import GridSearchCV, GroupKFold  # noqa: E402
 
@@ -67,7 +66,9 @@ def searches(quick):
 
 
 def timed_search(estimator, grid, X, y, groups, *, n_jobs=1, backend=None):
-    search = GridSearchCV(estimator, grid, cv=GroupKFold(min(4, len(np.unique(groups)))), n_jobs=n_jobs)
+    search = GridSearchCV(
+        estimator, grid, cv=GroupKFold(min(4, len(np.unique(groups)))), n_jobs=n_jobs
+    )
     start = time.perf_counter()
     if backend is None:
         search.fit(X, y, groups=groups)
@@ -113,22 +114,35 @@ def main(quick=False):
                 }
                 if client is not None:
                     configs["dask x2"] = dict(params={"n_jobs": 1}, n_jobs=None, backend="dask")
-                    configs["dask x2, nested"] = dict(params={"n_jobs": None}, n_jobs=None, backend="dask")
+                    configs["dask x2, nested"] = dict(
+                        params={"n_jobs": None}, n_jobs=None, backend="dask"
+                    )
                 serial_time, reference = None, None
                 for config, spec in configs.items():
                     est = clone(estimator).set_params(**spec["params"])
-                    seconds, results = timed_search(est, grid, X, y, groups, n_jobs=spec["n_jobs"],
-                                                    backend=spec.get("backend"))
+                    seconds, results = timed_search(
+                        est, grid, X, y, groups, n_jobs=spec["n_jobs"], backend=spec.get("backend")
+                    )
                     if reference is None:
                         serial_time, reference = seconds, results
                     same = np.array_equal(results["mean_test_score"], reference["mean_test_score"])
                     if not same:
-                        raise AssertionError(f"{name} on {data_name}: {config} differs from the serial search")
+                        raise AssertionError(
+                            f"{name} on {data_name}: {config} differs from the serial search"
+                        )
                     n_fits = len(results["params"]) * min(4, len(np.unique(groups)))
-                    rows.append({
-                        "data": data_name, "search": name, "clips": len(X), "fits": n_fits, "config": config,
-                        "seconds": seconds, "speed-up vs serial": serial_time / seconds, "scores equal": same,
-                    })
+                    rows.append(
+                        {
+                            "data": data_name,
+                            "search": name,
+                            "clips": len(X),
+                            "fits": n_fits,
+                            "config": config,
+                            "seconds": seconds,
+                            "speed-up vs serial": serial_time / seconds,
+                            "scores equal": same,
+                        }
+                    )
     finally:
         if client is not None:
             client.close()

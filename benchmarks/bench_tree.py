@@ -38,9 +38,13 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA, interleaved, time_call, write_results  # noqa: E402
-
 from sklearn.cluster import BisectingKMeans  # noqa: E402
-from sklearn.model_selection import GridSearchCV, GroupKFold, RepeatedStratifiedKFold, cross_val_score  # noqa: E402,E501
+from sklearn.model_selection import (
+    GridSearchCV,
+    GroupKFold,
+    RepeatedStratifiedKFold,
+    cross_val_score,
+)  # noqa: E402,E501
 from sklearn.neighbors import KNeighborsClassifier  # noqa: E402
 from sklearn.pipeline import make_pipeline  # noqa: E402
 
@@ -59,8 +63,13 @@ TREE_GRID = {
     "smoothing": [1.0, 10.0],
 }
 # The CMU windows have 192 channels: a smaller grid keeps the run within minutes.
-CMU_TREE_GRID = {"n_paths": [1, 3], "score_layers": [1, "all"], "split": ["median", "two_means"],
-                 "max_depth": [6, 8], "covariance_type": ["diag", "full"]}
+CMU_TREE_GRID = {
+    "n_paths": [1, 3],
+    "score_layers": [1, "all"],
+    "split": ["median", "two_means"],
+    "max_depth": [6, 8],
+    "covariance_type": ["diag", "full"],
+}
 QUICK_TREE_GRID = {"split": ["median"], "max_depth": [6], "covariance_type": ["diag", "full"]}
 HMM_STATES = (2, 3, 4, 6)
 REPEATS = 7  # timings are medians of this many runs (the machine is shared)
@@ -87,8 +96,15 @@ def synthetic():
 CMU_RATE = 30  # Hz, after the markers are computed at the recorded 120 Hz
 CMU_WINDOW, CMU_HOP, CMU_TRAIN_SHARE = 30, 15, 0.6  # frames at 30 Hz: 1 s windows, 0.5 s hop
 # Subject 02's trials by activity (cmu-index.csv descriptions, shortened)
-CMU_CLASSES = {"walk": "walk", "run/jog": "run", "jump, balance": "jump", "punch/strike": "punch",
-               "bend over, scoop up, rise, lift arm": "bend", "swordplay": "swordplay", "wash self": "wash"}
+CMU_CLASSES = {
+    "walk": "walk",
+    "run/jog": "run",
+    "jump, balance": "jump",
+    "punch/strike": "punch",
+    "bend over, scoop up, rise, lift arm": "bend",
+    "swordplay": "swordplay",
+    "wash self": "wash",
+}
 
 
 def cmu_markers(subjects):
@@ -159,7 +175,9 @@ class PerClassHMM:
         for c in self.classes_:
             clips = [(x - self.mu_) / self.sd_ for x, label in zip(X, y) if label == c]
             n_states = max(1, min(self.n_states, min(len(x) for x in clips)))
-            model = GaussianHMM(n_states, covariance_type="diag", n_iter=30, random_state=0, min_covar=1e-3)
+            model = GaussianHMM(
+                n_states, covariance_type="diag", n_iter=30, random_state=0, min_covar=1e-3
+            )
             self.models_.append(model.fit(np.vstack(clips), [len(x) for x in clips]))
         return self
 
@@ -190,7 +208,9 @@ def dtw_1nn():
         def fit(self, X, y):
             from tslearn.utils import to_time_series_dataset
 
-            self.model_ = KNeighborsTimeSeriesClassifier(n_neighbors=1, metric="dtw").fit(to_time_series_dataset(X), y)
+            self.model_ = KNeighborsTimeSeriesClassifier(n_neighbors=1, metric="dtw").fit(
+                to_time_series_dataset(X), y
+            )
             return self
 
         def predict(self, X):
@@ -215,41 +235,55 @@ def recognition(name, loader, quick):
     tree = search.best_estimator_
     # Variants of the chosen model: the fastest beam, diagonal covariances (the hmmlearn peer's), the paper's
     # single scored layer, and its node prior.
-    changes = [("n_paths=1", {"n_paths": 1}), ("covariance_type='diag'", {"covariance_type": "diag"}),
-               ("score_layers=1 (the paper's)", {"score_layers": 1}),
-               ("node_prior='graph' (the paper's)", {"node_prior": "graph"})]
+    changes = [
+        ("n_paths=1", {"n_paths": 1}),
+        ("covariance_type='diag'", {"covariance_type": "diag"}),
+        ("score_layers=1 (the paper's)", {"score_layers": 1}),
+        ("node_prior='graph' (the paper's)", {"node_prior": "graph"}),
+    ]
     variants = [("", tree)] + [
         (f", {label}", MotionTreeHMM(**{**search.best_params_, **change}).fit(Xtr, ytr))
-        for label, change in changes if any(tree.get_params()[k] != v for k, v in change.items())  # not the same model
+        for label, change in changes
+        if any(tree.get_params()[k] != v for k, v in change.items())  # not the same model
     ]
 
     n_states = choose_hmm(Xtr, ytr, splits)
     hmm = PerClassHMM(n_states).fit(Xtr, ytr)
     # Timed in alternation, so that all share the machine's load alike.
-    *tree_s, hmm_s = interleaved([lambda m=m: m.predict(Xte) for _, m in variants] + [lambda: hmm.scores(Xte)],
-                                 REPEATS)
+    *tree_s, hmm_s = interleaved(
+        [lambda m=m: m.predict(Xte) for _, m in variants] + [lambda: hmm.scores(Xte)], REPEATS
+    )
 
     length = int(np.median([len(x) for x in Xtr]))
-    euclid = make_pipeline(ResampleClips(n_frames=length), FlattenClips(), KNeighborsClassifier(1)).fit(Xtr, ytr)
+    euclid = make_pipeline(
+        ResampleClips(n_frames=length), FlattenClips(), KNeighborsClassifier(1)
+    ).fit(Xtr, ytr)
     euclid_s, _ = time_call(lambda: euclid.predict(Xte), repeats=REPEATS)
     dtw = dtw_1nn().fit(Xtr, ytr)
     dtw_s, _ = time_call(lambda: dtw.predict(Xte), repeats=1)
 
     chosen = ", ".join(f"{k}={v}" for k, v in sorted(search.best_params_.items()))
-    results = [(f"MotionTreeHMM{label}", chosen if not label else "as above", model, seconds)
-               for (label, model), seconds in zip(variants, tree_s)]
-    results += [("hmmlearn GaussianHMM per class", f"n_states={n_states}, diag", hmm, hmm_s),
-                ("1-NN DTW (tslearn)", "", dtw, dtw_s),
-                ("1-NN Euclidean (resampled)", f"n_frames={length}", euclid, euclid_s)]
-    rows = [{
-        "dataset": name,
-        "method": method,
-        "chosen by CV on train": params,
-        "test accuracy": float(np.mean(model.predict(Xte) == yte)),
-        "predict s": seconds,
-        "clips/s": len(Xte) / seconds,
-        "throughput vs hmmlearn": hmm_s / seconds,
-    } for method, params, model, seconds in results]
+    results = [
+        (f"MotionTreeHMM{label}", chosen if not label else "as above", model, seconds)
+        for (label, model), seconds in zip(variants, tree_s)
+    ]
+    results += [
+        ("hmmlearn GaussianHMM per class", f"n_states={n_states}, diag", hmm, hmm_s),
+        ("1-NN DTW (tslearn)", "", dtw, dtw_s),
+        ("1-NN Euclidean (resampled)", f"n_frames={length}", euclid, euclid_s),
+    ]
+    rows = [
+        {
+            "dataset": name,
+            "method": method,
+            "chosen by CV on train": params,
+            "test accuracy": float(np.mean(model.predict(Xte) == yte)),
+            "predict s": seconds,
+            "clips/s": len(Xte) / seconds,
+            "throughput vs hmmlearn": hmm_s / seconds,
+        }
+        for method, params, model, seconds in results
+    ]
     return rows, tree
 
 
@@ -264,17 +298,24 @@ def score_layers_study(name, loader, quick):
     for covariance_type in ["full"] if quick else ["diag", "full"]:
         for max_depth in [6, 8] if quick else [6, 8, 10, 12]:
             for score_layers in [1, 3, "all"]:
-                model = MotionTreeHMM(max_depth=max_depth, score_layers=score_layers, split="two_means",
-                                      min_samples_leaf=4, covariance_type=covariance_type)
+                model = MotionTreeHMM(
+                    max_depth=max_depth,
+                    score_layers=score_layers,
+                    split="two_means",
+                    min_samples_leaf=4,
+                    covariance_type=covariance_type,
+                )
                 cv = cross_val_score(model, Xtr, ytr, cv=splits, n_jobs=2)
-                rows.append({
-                    "dataset": name,
-                    "covariance_type": covariance_type,
-                    "max_depth": max_depth,
-                    "score_layers": score_layers,
-                    "CV accuracy (train)": float(cv.mean()),
-                    "test accuracy": float(model.fit(Xtr, ytr).score(Xte, yte)),
-                })
+                rows.append(
+                    {
+                        "dataset": name,
+                        "covariance_type": covariance_type,
+                        "max_depth": max_depth,
+                        "score_layers": score_layers,
+                        "CV accuracy (train)": float(cv.mean()),
+                        "test accuracy": float(model.fit(Xtr, ytr).score(Xte, yte)),
+                    }
+                )
     return rows
 
 
@@ -289,14 +330,16 @@ def selection_study(name, loader, seeds=range(5)):
         for seed in seeds:
             cv = RepeatedStratifiedKFold(n_splits=5, n_repeats=repeats, random_state=seed)
             search = GridSearchCV(MotionTreeHMM(), TREE_GRID, cv=cv, n_jobs=2).fit(Xtr, ytr)
-            rows.append({
-                "dataset": name,
-                "folds": f"stratified 5-fold x {repeats}",
-                "seed": seed,
-                "chosen": ", ".join(f"{k}={v}" for k, v in sorted(search.best_params_.items())),
-                "CV accuracy (train)": float(search.best_score_),
-                "test accuracy": float(search.best_estimator_.score(Xte, yte)),
-            })
+            rows.append(
+                {
+                    "dataset": name,
+                    "folds": f"stratified 5-fold x {repeats}",
+                    "seed": seed,
+                    "chosen": ", ".join(f"{k}={v}" for k, v in sorted(search.best_params_.items())),
+                    "CV accuracy (train)": float(search.best_score_),
+                    "test accuracy": float(search.best_estimator_.score(Xte, yte)),
+                }
+            )
     return rows
 
 
@@ -306,7 +349,9 @@ def selection_study(name, loader, seeds=range(5)):
 def scaling_frames(n_max):
     """Joint angles (60 channels, no root) of synthetic motions at 120 Hz, standardised."""
     clips_needed = int(np.ceil(n_max / 1200 / 7)) + 1
-    data = make_motions(n_clips_per_class=clips_needed, frame_rate=120.0, duration=(8.0, 12.0), random_state=0)
+    data = make_motions(
+        n_clips_per_class=clips_needed, frame_rate=120.0, duration=(8.0, 12.0), random_state=0
+    )
     frames = np.vstack([c[:, 6:] for c in data.clips])[:n_max]
     spread = frames.std(axis=0)
     return (frames - frames.mean(axis=0)) / np.where(spread > 0, spread, 1.0)
@@ -347,17 +392,19 @@ def scaling(quick):
                 BisectingKMeans(n_clusters=leaves, random_state=0).fit(X)
                 bkm = time.perf_counter() - start
             times.append(seconds)
-            rows.append({
-                "tree": label,
-                "frames": n,
-                "layers": tree.n_layers,
-                "leaves": leaves,
-                "build s": seconds,
-                "peak MB": memory / 2**20,
-                "BisectingKMeans s (same leaves)": bkm,
-                "tree / BisectingKMeans": seconds / bkm if bkm else "",
-                "growth exponent": "",
-            })
+            rows.append(
+                {
+                    "tree": label,
+                    "frames": n,
+                    "layers": tree.n_layers,
+                    "leaves": leaves,
+                    "build s": seconds,
+                    "peak MB": memory / 2**20,
+                    "BisectingKMeans s (same leaves)": bkm,
+                    "tree / BisectingKMeans": seconds / bkm if bkm else "",
+                    "growth exponent": "",
+                }
+            )
         exponent = np.polyfit(np.log(sizes[: len(times)]), np.log(times), 1)[0]
         rows[-1]["growth exponent"] = float(exponent)
     return rows
@@ -375,11 +422,16 @@ def cmu_layer_datasets():
     subjects = np.array([t.split("_")[0] for t in data.trials])
     sets = {}
     for name, mask in [(f"CMU subject {s}", subjects == s) for s in ("01", "02", "03")] + [
-            ("CMU subjects 01-03", np.ones(len(clips), dtype=bool))]:
+        ("CMU subjects 01-03", np.ones(len(clips), dtype=bool))
+    ]:
         chosen = [c for c, m in zip(clips, mask) if m]
         # decode a 10 s stretch of the subject's longest trial
         longest = max(chosen, key=len)
-        sets[name] = (chosen, np.asarray(data.description, dtype=str)[mask], longest[: 10 * CMU_RATE])
+        sets[name] = (
+            chosen,
+            np.asarray(data.description, dtype=str)[mask],
+            longest[: 10 * CMU_RATE],
+        )
     return sets
 
 
@@ -392,18 +444,24 @@ def layer_table(datasets, quick):
         layers = sorted({0, bottom} | {2**i for i in range(12) if 2**i < bottom})
         if quick:
             layers = [layer for layer in layers if layer <= 8]
-        decode_ms = [1e3 * time_call(lambda layer=layer: model.decode([clip], layer=layer), repeats=3)[0]
-                     for layer in layers]
-        rows.append({
-            "data": name,
-            "frames": int(tree.count[0]),
-            "layers": tree.n_layers,
-            "nodes": tree.n_tree_nodes,
-            "nodes, copies counted": int(tree.n_nodes.sum()),
-            "nodes in bottom layer": int(tree.n_nodes[-1]),
-            "decoded clip frames": len(clip),
-            "decode ms at layer": ", ".join(f"{layer}: {t:.1f}" for layer, t in zip(layers, decode_ms)),
-        })
+        decode_ms = [
+            1e3 * time_call(lambda layer=layer: model.decode([clip], layer=layer), repeats=3)[0]
+            for layer in layers
+        ]
+        rows.append(
+            {
+                "data": name,
+                "frames": int(tree.count[0]),
+                "layers": tree.n_layers,
+                "nodes": tree.n_tree_nodes,
+                "nodes, copies counted": int(tree.n_nodes.sum()),
+                "nodes in bottom layer": int(tree.n_nodes[-1]),
+                "decoded clip frames": len(clip),
+                "decode ms at layer": ", ".join(
+                    f"{layer}: {t:.1f}" for layer, t in zip(layers, decode_ms)
+                ),
+            }
+        )
     return rows
 
 
@@ -447,13 +505,19 @@ LAYER_NOTES = (
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="small grids and sizes (a smoke run)")
-    parser.add_argument("--only", choices=["recognition", "score_layers", "scaling", "layers", "selection"],
-                        help="run one table only (selection, about 25 minutes, runs only when asked)")
+    parser.add_argument(
+        "--only",
+        choices=["recognition", "score_layers", "scaling", "layers", "selection"],
+        help="run one table only (selection, about 25 minutes, runs only when asked)",
+    )
     args = parser.parse_args()
     loaders = {"synthetic (subject 3 held out)": synthetic}
     if (SHARED_DATA / "uea").is_dir():
-        loaders = {"BasicMotions": lambda: uea("BasicMotions"), "JapaneseVowels": lambda: uea("JapaneseVowels"),
-                   **loaders}
+        loaders = {
+            "BasicMotions": lambda: uea("BasicMotions"),
+            "JapaneseVowels": lambda: uea("JapaneseVowels"),
+            **loaders,
+        }
     else:
         print(f"UEA: not found in {SHARED_DATA}, its rows are left out")
     if (SHARED_DATA / "cmu-asfamc").is_dir():
@@ -461,21 +525,39 @@ def main():
     else:
         print(f"CMU: not found in {SHARED_DATA}, its rows are left out")
     if args.only in (None, "recognition"):
-        rows = [row for name, loader in loaders.items() for row in recognition(name, loader, args.quick)[0]]
+        rows = [
+            row
+            for name, loader in loaders.items()
+            for row in recognition(name, loader, args.quick)[0]
+        ]
         write_results("tree_recognition", rows, notes=RECOGNITION_NOTES)
     if args.only in (None, "score_layers"):
-        studied = {name: loader for name, loader in loaders.items() if name in ("BasicMotions", "JapaneseVowels")}
-        rows = [row for name, loader in studied.items() for row in score_layers_study(name, loader, args.quick)]
+        studied = {
+            name: loader
+            for name, loader in loaders.items()
+            if name in ("BasicMotions", "JapaneseVowels")
+        }
+        rows = [
+            row
+            for name, loader in studied.items()
+            for row in score_layers_study(name, loader, args.quick)
+        ]
         if rows:
             write_results("tree_score_layers", rows, notes=SCORE_LAYERS_NOTES)
     if args.only == "selection" and "JapaneseVowels" in loaders:
-        write_results("tree_selection", selection_study("JapaneseVowels", loaders["JapaneseVowels"]),
-                      notes=SELECTION_NOTES)
+        write_results(
+            "tree_selection",
+            selection_study("JapaneseVowels", loaders["JapaneseVowels"]),
+            notes=SELECTION_NOTES,
+        )
     if args.only in (None, "scaling"):
         write_results("tree_scaling", scaling(args.quick), notes=SCALING_NOTES)
     if args.only in (None, "layers"):
-        tables = {name: tuple(loader()[i] for i in (0, 1, 2)) for name, loader in loaders.items()
-                  if not name.startswith("CMU")}
+        tables = {
+            name: tuple(loader()[i] for i in (0, 1, 2))
+            for name, loader in loaders.items()
+            if not name.startswith("CMU")
+        }
         tables.update(cmu_layer_datasets())
         write_results("tree_layers", layer_table(tables, args.quick), notes=LAYER_NOTES)
 

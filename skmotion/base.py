@@ -247,5 +247,7 @@ class ClipFeatureMixin(ClipEstimatorMixin, _OutputConfigMixin):
         labels = clips_in.container.clip_labels
         index = labels if labels is not None else pd.RangeIndex(len(table))
         if clips_in.container.index_names:
-            index = pd.Index(np.asarray(index, dtype=object), name=clips_in.container.index_names[0])
+            index = pd.Index(
+                np.asarray(index, dtype=object), name=clips_in.container.index_names[0]
+            )
         return pd.DataFrame(table, index=index, columns=self.get_feature_names_out())

@@ -17,9 +17,13 @@ def _demo(args):
     options = {}
     sections = SECTIONS
     if args.data is not None:
-        sections = tuple("skmotion._demo.data_folder" if s == "skmotion._demo.data" else s for s in SECTIONS)
+        sections = tuple(
+            "skmotion._demo.data_folder" if s == "skmotion._demo.data" else s for s in SECTIONS
+        )
         options = {"data_folder": args.data, "frame_rate": args.frame_rate}
-    run_demo(print, random_state=args.random_state, sections=sections, plot_dir=args.plots, **options)
+    run_demo(
+        print, random_state=args.random_state, sections=sections, plot_dir=args.plots, **options
+    )
     print("")
     print(f"done in {time.perf_counter() - start:.1f} s")
     return 0
@@ -48,20 +52,36 @@ def build_parser():
     demo = commands.add_parser(
         "demo", help="run the main job on the built-in synthetic data and print a report"
     )
-    demo.add_argument("--random-state", type=int, default=0, help="seed of the data and models (default 0)")
     demo.add_argument(
-        "--data", metavar="FOLDER", default=None,
+        "--random-state", type=int, default=0, help="seed of the data and models (default 0)"
+    )
+    demo.add_argument(
+        "--data",
+        metavar="FOLDER",
+        default=None,
         help="run on the motion files under FOLDER (BVH files and ASF/AMC subject folders; labels from "
         "subfolder names or from a CMU index CSV at the top of FOLDER) instead of the synthetic data",
     )
     demo.add_argument(
-        "--frame-rate", type=float, default=30.0, help="with --data: resample every clip to this rate (default 30 Hz)"
+        "--frame-rate",
+        type=float,
+        default=30.0,
+        help="with --data: resample every clip to this rate (default 30 Hz)",
     )
-    demo.add_argument("--plots", metavar="DIR", default=None, help="save the sections' figures in DIR (needs matplotlib)")
+    demo.add_argument(
+        "--plots",
+        metavar="DIR",
+        default=None,
+        help="save the sections' figures in DIR (needs matplotlib)",
+    )
     demo.set_defaults(func=_demo)
-    info = commands.add_parser("info", help="print a motion file's skeleton, channels, frame rate and duration")
+    info = commands.add_parser(
+        "info", help="print a motion file's skeleton, channels, frame rate and duration"
+    )
     info.add_argument("file", help="a .bvh, .amc or .asf file")
-    info.add_argument("--asf", default=None, help="the skeleton of an .amc file (default: NN.asf beside it)")
+    info.add_argument(
+        "--asf", default=None, help="the skeleton of an .amc file (default: NN.asf beside it)"
+    )
     info.set_defaults(func=_info)
     return parser
 

@@ -25,9 +25,13 @@ def _per_query_counts(candidates, y_query, y_stored, query_ids):
     y_query = np.asarray(y_query)
     y_stored = np.asarray(y_stored)
     if len(candidates) != len(y_query):
-        raise ValueError(f"candidates holds {len(candidates)} sets, but y_query has {len(y_query)} labels.")
+        raise ValueError(
+            f"candidates holds {len(candidates)} sets, but y_query has {len(y_query)} labels."
+        )
     if query_ids is not None and len(query_ids) != len(y_query):
-        raise ValueError(f"query_ids has {len(query_ids)} ids, but y_query has {len(y_query)} labels.")
+        raise ValueError(
+            f"query_ids has {len(query_ids)} ids, but y_query has {len(y_query)} labels."
+        )
     labels, stored_codes = np.unique(y_stored, return_inverse=True)
     per_label = np.bincount(stored_codes, minlength=len(labels))
     counts = np.zeros((len(y_query), 4), dtype=np.int64)
@@ -248,7 +252,9 @@ class _PruningAtRecall:
         return f"make_pruning_scorer(min_recall={self.min_recall!r})"
 
 
-@validate_params({"min_recall": [Interval(Real, 0, 1, closed="both")]}, prefer_skip_nested_validation=True)
+@validate_params(
+    {"min_recall": [Interval(Real, 0, 1, closed="both")]}, prefer_skip_nested_validation=True
+)
 def make_pruning_scorer(min_recall=0.99):
     """A scorer that rewards pruning only while recall stays at or above a bound.
 
@@ -292,13 +298,19 @@ class _SearchScores:
 
     def __call__(self, estimator, X, y):
         pruning, found = _search_quality(estimator, X, y)
-        return {"pruning": pruning, "recall": found, "pruning_at_recall": _bounded(pruning, found, self.min_recall)}
+        return {
+            "pruning": pruning,
+            "recall": found,
+            "pruning_at_recall": _bounded(pruning, found, self.min_recall),
+        }
 
     def __repr__(self):
         return f"make_search_scorer(min_recall={self.min_recall!r})"
 
 
-@validate_params({"min_recall": [Interval(Real, 0, 1, closed="both")]}, prefer_skip_nested_validation=True)
+@validate_params(
+    {"min_recall": [Interval(Real, 0, 1, closed="both")]}, prefer_skip_nested_validation=True
+)
 def make_search_scorer(min_recall=0.99):
     """One scorer giving pruning, recall and the bounded pruning together.
 

@@ -112,8 +112,12 @@ def outputs(estimator, X, y=None):
     for method in OUTPUT_METHODS:
         if hasattr(estimator, method):
             results[method] = _as_list(getattr(estimator, method)(X))
-    if hasattr(estimator, "score") and (y is not None or not (is_classifier(estimator) or is_regressor(estimator))):
-        results["score"] = [np.asarray(estimator.score(X, y) if y is not None else estimator.score(X))]
+    if hasattr(estimator, "score") and (
+        y is not None or not (is_classifier(estimator) or is_regressor(estimator))
+    ):
+        results["score"] = [
+            np.asarray(estimator.score(X, y) if y is not None else estimator.score(X))
+        ]
     return results
 
 
@@ -126,7 +130,9 @@ def assert_outputs_equal(expected, actual, *, exact=True, context=""):
             if u.dtype.kind in "fc" and exact:
                 np.testing.assert_array_equal(u, v, err_msg=f"{context}: {method}[{i}] differs")
             elif u.dtype.kind in "fc":
-                np.testing.assert_allclose(u, v, rtol=1e-9, atol=1e-12, err_msg=f"{context}: {method}[{i}]")
+                np.testing.assert_allclose(
+                    u, v, rtol=1e-9, atol=1e-12, err_msg=f"{context}: {method}[{i}]"
+                )
             else:
                 np.testing.assert_array_equal(u, v, err_msg=f"{context}: {method}[{i}] differs")
 
@@ -148,7 +154,9 @@ def scoring_model(estimator, y):
     if y is None or is_classifier(estimator) or is_regressor(estimator):
         return estimator
     if kind == "clips":
-        return make_pipeline(estimator, ResampleClips(n_frames=8), FlattenClips(), LogisticRegression(max_iter=500))
+        return make_pipeline(
+            estimator, ResampleClips(n_frames=8), FlattenClips(), LogisticRegression(max_iter=500)
+        )
     return make_pipeline(estimator, LogisticRegression(max_iter=500))
 
 
@@ -217,8 +225,15 @@ def check_containers_agree(estimator, X, y):
         for method in ("transform",):
             if hasattr(est, method) and motion_tags(est).output_kind == "clips":
                 out = getattr(est, method)(data)
-                expected = {"list": list, "tuple": tuple, "ndarray": np.ndarray, "dataframe": pd.DataFrame}[kind]
-                assert isinstance(out, expected), f"{method} on a {kind} returned {type(out).__name__}"
+                expected = {
+                    "list": list,
+                    "tuple": tuple,
+                    "ndarray": np.ndarray,
+                    "dataframe": pd.DataFrame,
+                }[kind]
+                assert isinstance(out, expected), (
+                    f"{method} on a {kind} returned {type(out).__name__}"
+                )
 
 
 def check_pickle(estimator, X, y):

@@ -17,7 +17,9 @@ settings.register_profile(
 settings.load_profile("skmotion")
 
 SHARED_DATA = Path(
-    os.environ.get("SKMOTION_SHARED_DATA", Path(__file__).resolve().parents[1] / ".." / "shared" / "data")
+    os.environ.get(
+        "SKMOTION_SHARED_DATA", Path(__file__).resolve().parents[1] / ".." / "shared" / "data"
+    )
 ).resolve()
 
 

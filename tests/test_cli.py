@@ -37,5 +37,7 @@ def test_version_and_help(capsys):
 
 
 def test_python_dash_m():
-    result = subprocess.run([sys.executable, "-m", "skmotion", "--version"], capture_output=True, text=True, check=True)
+    result = subprocess.run(
+        [sys.executable, "-m", "skmotion", "--version"], capture_output=True, text=True, check=True
+    )
     assert result.stdout.strip() == f"skmotion {__version__}"

@@ -23,7 +23,9 @@ def test_info_bvh(bvh_file, capsys):
     assert main(["info", str(bvh_file)]) == 0
     out = capsys.readouterr().out
     assert "format: BVH" in out
-    assert "skeleton: 26 joints (21 with channels or children, 5 end sites), root 'Hips', y-up" in out
+    assert (
+        "skeleton: 26 joints (21 with channels or children, 5 end sites), root 'Hips', y-up" in out
+    )
     assert "channels: 66: Hips_Xposition, Hips_Yposition" in out
     assert "frames: 60 at 30 Hz, duration 2.00 s" in out
     assert "marker preset: humanoid" in out
@@ -53,8 +55,14 @@ def test_demo_has_the_marker_section(demo_report):
 
 
 def test_demo_on_a_folder_of_files(tmp_path, capsys):
-    data = make_motions(n_clips_per_class=3, n_subjects=3, classes=["walk", "squat"], duration=(1.0, 1.5),
-                        frame_rate=60.0, random_state=1)
+    data = make_motions(
+        n_clips_per_class=3,
+        n_subjects=3,
+        classes=["walk", "squat"],
+        duration=(1.0, 1.5),
+        frame_rate=60.0,
+        random_state=1,
+    )
     for k, motion in enumerate(as_motions(data.clips, data.skeletons, data.frame_rate)):
         folder = tmp_path / str(data.target_names[data.target[k]])
         folder.mkdir(exist_ok=True)
@@ -75,14 +83,20 @@ def test_demo_on_the_shared_data(shared_data, capsys, monkeypatch):
     original = data_folder.load_motion_folder
 
     def smaller(folder, index=None):
-        data = original(pathlib.Path(folder) / "cmu-bvh")  # the real CC files (two skeletons); quick
+        data = original(
+            pathlib.Path(folder) / "cmu-bvh"
+        )  # the real CC files (two skeletons); quick
         calls.append(folder)
         return data
 
     monkeypatch.setattr(data_folder, "load_motion_folder", smaller)
     assert main(["demo", "--data", str(shared_data)]) == 0
     out = capsys.readouterr().out
-    assert calls and "12 clips (12 BVH" in out and "virtual markers (the files hold several skeletons)" in out
+    assert (
+        calls
+        and "12 clips (12 BVH" in out
+        and "virtual markers (the files hold several skeletons)" in out
+    )
     assert "character_creator 12 clips" in out
     heights = out.split("median height over all frames: ")[1]
     assert 0.9 < float(heights.split("head_top ")[1].split(",")[0]) < 1.1

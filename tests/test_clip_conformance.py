@@ -56,7 +56,9 @@ class SkipsChannelCheck(ClipMeanCentroid):
 class IgnoresSeed(ClipMeanCentroid):
     def fit(self, X, y):
         super().fit(X, y)
-        self.centroids_ = self.centroids_ + np.random.default_rng().normal(size=self.centroids_.shape)
+        self.centroids_ = self.centroids_ + np.random.default_rng().normal(
+            size=self.centroids_.shape
+        )
         return self
 
 
@@ -93,7 +95,9 @@ def _data():
     return X, np.array(["a", "b", "c"] * 3)
 
 
-@cc.parametrize_with_clip_checks([cc.ClipCase(ClipMeanCentroid(), _data, param_grid={"shrink": [0.0, 0.1]})])
+@cc.parametrize_with_clip_checks(
+    [cc.ClipCase(ClipMeanCentroid(), _data, param_grid={"shrink": [0.0, 0.1]})]
+)
 def test_correct_estimator_passes(check):
     check()
 

@@ -15,7 +15,9 @@ def test_recognition_section(capsys):
     context = run_demo(lines.append, sections=SECTIONS)
     text = "\n".join(lines)
     assert "== Recognition: the motion database (MotionTreeHMM) ==" in text
-    accuracy = float(re.search(r"tested on subject \S+ \((\d+) clips\): accuracy ([\d.]+)", text).group(2))
+    accuracy = float(
+        re.search(r"tested on subject \S+ \((\d+) clips\): accuracy ([\d.]+)", text).group(2)
+    )
     assert accuracy >= 0.8
     # the confusion table counts every test clip once
     start = lines.index("confusion (rows: true, columns: predicted):") + 2

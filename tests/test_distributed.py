@@ -20,9 +20,15 @@ dask = pytest.importorskip("dask")
 @pytest.fixture(scope="module")
 def client():
     # Generous timeouts: the CI box has two cores shared by everything else.
-    with dask.config.set({"distributed.comm.timeouts.connect": "60s", "distributed.comm.timeouts.tcp": "120s"}):
+    with dask.config.set(
+        {"distributed.comm.timeouts.connect": "60s", "distributed.comm.timeouts.tcp": "120s"}
+    ):
         cluster = distributed.LocalCluster(
-            n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=None,
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
         )
         try:
             # Connect by address, as to a remote scheduler ("tcp://scheduler:8786").
@@ -50,7 +56,9 @@ class CountingClips(list):
 
 @pytest.fixture(scope="module")
 def motions():
-    data = make_motions(n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1)
+    data = make_motions(
+        n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1
+    )
     return [c[:, 6:] for c in data.clips], data.target_names[data.target], data.groups
 
 
@@ -80,25 +88,38 @@ def test_grid_search_on_dask_equals_serial(client, motions, estimator, grid):
     X, y, groups = motions
     serial = GridSearchCV(estimator, grid, cv=GroupKFold(3)).fit(X, y, groups=groups)
     on_dask = GridSearchCV(estimator, grid, cv=GroupKFold(3))
-    with distributed.get_task_stream(client) as stream, joblib.parallel_backend("dask", scatter=[X, y]):
+    with (
+        distributed.get_task_stream(client) as stream,
+        joblib.parallel_backend("dask", scatter=[X, y]),
+    ):
         on_dask.fit(X, y, groups=groups)
     workers = {task["worker"] for task in stream.data}
-    assert workers and workers <= set(client.scheduler_info(n_workers=-1)["workers"]), "the fits ran on the cluster"
+    assert workers and workers <= set(client.scheduler_info(n_workers=-1)["workers"]), (
+        "the fits ran on the cluster"
+    )
     assert_searches_equal(serial, on_dask, X)
 
 
 def test_scattered_clips_are_sent_once(client, motions):
     X, y, groups = motions
-    search = GridSearchCV(IntervalIndexNeighbors(n_levels=3), {"epsilon": [0.5, 1.0, 1.5]}, cv=GroupKFold(3))
+    search = GridSearchCV(
+        IntervalIndexNeighbors(n_levels=3), {"epsilon": [0.5, 1.0, 1.5]}, cv=GroupKFold(3)
+    )
     clips = CountingClips(X)
     CountingClips.pickles = 0
     with joblib.parallel_backend("dask", scatter=[clips, y]):
         search.fit(clips, y, groups=groups)
-    assert CountingClips.pickles == 1, "scattered clips are pickled once, whatever the number of tasks"
+    assert CountingClips.pickles == 1, (
+        "scattered clips are pickled once, whatever the number of tasks"
+    )
     scattered = search.cv_results_
 
     CountingClips.pickles = 0
     with joblib.parallel_backend("dask"):
         search.fit(clips, y, groups=groups)
-    assert CountingClips.pickles > 1, "without scatter a list of clips is sent again with every batch of tasks"
-    np.testing.assert_array_equal(search.cv_results_["mean_test_score"], scattered["mean_test_score"])
+    assert CountingClips.pickles > 1, (
+        "without scatter a list of clips is sent again with every batch of tasks"
+    )
+    np.testing.assert_array_equal(
+        search.cv_results_["mean_test_score"], scattered["mean_test_score"]
+    )

@@ -17,7 +17,9 @@ NEEDS_MODULE = re.compile(r"^# doc: needs module (\S+)$", flags=re.M)
 
 
 def _python_blocks(path):
-    return [textwrap.dedent(b) for b in re.findall(r"```python\n(.*?)```", path.read_text(), flags=re.S)]
+    return [
+        textwrap.dedent(b) for b in re.findall(r"```python\n(.*?)```", path.read_text(), flags=re.S)
+    ]
 
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.name)
@@ -47,7 +49,11 @@ def test_readme_gives_the_two_setup_commands():
 
 def test_architecture_lists_every_module():
     text = (ROOT / "docs" / "architecture.md").read_text()
-    modules = [p.relative_to(ROOT).as_posix() for pattern in ("*.py", "*.pyx")
-               for p in (ROOT / "skmotion").rglob(pattern) if p.name != "__init__.py"]
+    modules = [
+        p.relative_to(ROOT).as_posix()
+        for pattern in ("*.py", "*.pyx")
+        for p in (ROOT / "skmotion").rglob(pattern)
+        if p.name != "__init__.py"
+    ]
     missing = [m for m in modules if Path(m).name not in text]
     assert not missing, f"docs/architecture.md does not mention {missing}"

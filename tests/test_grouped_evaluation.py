@@ -20,8 +20,13 @@ from skmotion.preprocessing import FlattenClips, ResampleClips
 
 @pytest.fixture(scope="module")
 def motions():
-    data = make_motions(n_clips_per_class=4, n_subjects=4, classes=["walk", "jump", "wave", "squat"],
-                        duration=(0.8, 1.2), random_state=0)
+    data = make_motions(
+        n_clips_per_class=4,
+        n_subjects=4,
+        classes=["walk", "jump", "wave", "squat"],
+        duration=(0.8, 1.2),
+        random_state=0,
+    )
     clips = [c[:, 6:] for c in data.clips]
     subject_of = {id(c): s for c, s in zip(clips, data.groups)}
     return clips, data.target, data.groups, subject_of
@@ -60,15 +65,24 @@ def test_nested_search_routes_groups_to_the_inner_split(motions, monkeypatch):
     clips, y, groups, subject_of = motions
     monkeypatch.setattr(RecordingGroupKFold, "log", [])
     monkeypatch.setattr(RecordingGroupKFold, "subject_of", subject_of)
-    search = GridSearchCV(IntervalIndexNeighbors(n_levels=3), {"epsilon": [0.5, 1.0]}, cv=RecordingGroupKFold(3))
+    search = GridSearchCV(
+        IntervalIndexNeighbors(n_levels=3), {"epsilon": [0.5, 1.0]}, cv=RecordingGroupKFold(3)
+    )
     with sklearn.config_context(enable_metadata_routing=True):
-        result = cross_validate(search, clips, y, cv=GroupKFold(4), params={"groups": groups},
-                                return_estimator=True)
+        result = cross_validate(
+            search, clips, y, cv=GroupKFold(4), params={"groups": groups}, return_estimator=True
+        )
     inner = RecordingGroupKFold.log
-    assert len(inner) == 4 * 3, "3 inner splits in each of the 4 outer folds (the refit does not split)"
+    assert len(inner) == 4 * 3, (
+        "3 inner splits in each of the 4 outer folds (the refit does not split)"
+    )
     for train_subjects, test_subjects in inner:
-        assert train_subjects.isdisjoint(test_subjects), f"subject on both sides: {train_subjects & test_subjects}"
-        assert len(train_subjects) == 2 and len(test_subjects) == 1  # 3 subjects per outer training set
+        assert train_subjects.isdisjoint(test_subjects), (
+            f"subject on both sides: {train_subjects & test_subjects}"
+        )
+        assert (
+            len(train_subjects) == 2 and len(test_subjects) == 1
+        )  # 3 subjects per outer training set
     # Each outer fold's search saw only the three subjects of its training set.
     seen = [set().union(*(a | b for a, b in inner[3 * k : 3 * k + 3])) for k in range(4)]
     assert sorted(len(s) for s in seen) == [3, 3, 3, 3] and len(set(map(frozenset, seen))) == 4
@@ -78,7 +92,11 @@ def test_nested_search_routes_groups_to_the_inner_split(motions, monkeypatch):
 
 def test_nested_search_without_routing_has_no_groups(motions):
     clips, y, groups, _ = motions
-    search = GridSearchCV(IntervalIndexNeighbors(n_levels=3), {"epsilon": [0.5, 1.0]}, cv=GroupKFold(3))
+    search = GridSearchCV(
+        IntervalIndexNeighbors(n_levels=3), {"epsilon": [0.5, 1.0]}, cv=GroupKFold(3)
+    )
     # Without metadata routing the inner GroupKFold never receives the subjects.
     with pytest.raises(ValueError, match="groups"):
-        cross_validate(clone(search), clips, y, groups=groups, cv=GroupKFold(4), error_score="raise")
+        cross_validate(
+            clone(search), clips, y, groups=groups, cv=GroupKFold(4), error_score="raise"
+        )

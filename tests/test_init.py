@@ -35,10 +35,14 @@ def test_import_is_light_and_loads_no_optional_dependency():
         "heavy = [m for m in ('matplotlib', 'dask', 'distributed', 'mujoco', 'hmmlearn', 'tslearn') if m in sys.modules]; "
         "print(heavy)"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
     assert out.strip() == "[]"
     out = subprocess.run(
         [sys.executable, "-c", "import sys, skmotion; print('sklearn' in sys.modules)"],
-        capture_output=True, text=True, check=True,
+        capture_output=True,
+        text=True,
+        check=True,
     ).stdout
     assert out.strip() == "False"

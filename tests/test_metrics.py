@@ -25,7 +25,9 @@ def test_hand_counted():
     # a: 1 of 3 irrelevant returned -> 2/3 pruned, 2/3 of the a's found
     # b: 1 of 4 irrelevant returned -> 3/4 pruned, 1/2 of the b's found
     # c: everything returned -> 0 pruned, 1/1 found
-    assert pruning_efficiency(candidates, y_query, Y_STORED) == pytest.approx((2 / 3 + 3 / 4 + 0) / 3)
+    assert pruning_efficiency(candidates, y_query, Y_STORED) == pytest.approx(
+        (2 / 3 + 3 / 4 + 0) / 3
+    )
     assert recall(candidates, y_query, Y_STORED) == pytest.approx((2 / 3 + 1 / 2 + 1) / 3)
 
 
@@ -56,7 +58,9 @@ def test_errors():
 
 @pytest.fixture(scope="module")
 def fitted():
-    data = make_repeated_motions(n_motions_per_class=2, n_repeats=4, duration=(1.5, 2.5), random_state=1)
+    data = make_repeated_motions(
+        n_motions_per_class=2, n_repeats=4, duration=(1.5, 2.5), random_state=1
+    )
     train = np.arange(len(data.clips)) % 4 != 0
     clips_train = [c for c, t in zip(data.clips, train) if t]
     clips_test = [c for c, t in zip(data.clips, train) if not t]
@@ -71,8 +75,12 @@ def test_scorers_on_an_index_and_a_pipeline(fitted):
     assert recall_scorer(index, X_test, y_test) == recall(candidates, y_test, y_train)
     # In a Pipeline, the steps before the index transform the queries first.
     scale = FunctionTransformer(lambda X: [2.0 * c for c in X])
-    pipe = make_pipeline(scale, IntervalIndexNeighbors(n_levels=5, epsilon=0.8)).fit(X_train, y_train)
-    assert pruning_scorer(pipe, X_test, y_test) == pytest.approx(pruning_scorer(index, X_test, y_test))
+    pipe = make_pipeline(scale, IntervalIndexNeighbors(n_levels=5, epsilon=0.8)).fit(
+        X_train, y_train
+    )
+    assert pruning_scorer(pipe, X_test, y_test) == pytest.approx(
+        pruning_scorer(index, X_test, y_test)
+    )
 
 
 def test_bounded_scorer_rewards_pruning_only_at_the_recall_bound(fitted):
@@ -80,7 +88,9 @@ def test_bounded_scorer_rewards_pruning_only_at_the_recall_bound(fitted):
     index = IntervalIndexNeighbors(n_levels=5, epsilon=0.5).fit(X_train, y_train)
     pruning, found = pruning_scorer(index, X_test, y_test), recall_scorer(index, X_test, y_test)
     assert make_pruning_scorer(min_recall=found)(index, X_test, y_test) == pruning
-    assert make_pruning_scorer(min_recall=min(1.0, found + 0.01))(index, X_test, y_test) == pytest.approx(found - 1)
+    assert make_pruning_scorer(min_recall=min(1.0, found + 0.01))(
+        index, X_test, y_test
+    ) == pytest.approx(found - 1)
     assert "min_recall=0.9" in repr(make_pruning_scorer(0.9))
 
 

@@ -13,13 +13,10 @@ import pytest
 from sklearn.base import clone
 
 from skmotion.datasets import humanoid_skeleton, make_motions
-from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
-from skmotion.decomposition import _clip_svd
-from skmotion.neighbors import IntervalIndexNeighbors, pairwise_psi
-from skmotion.neighbors import _interval_neighbors, _psi
+from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor, _clip_svd
+from skmotion.neighbors import IntervalIndexNeighbors, _interval_neighbors, _psi, pairwise_psi
 from skmotion.preprocessing import LowPassFilter, VirtualMarkerTransform
-from skmotion.tree import MotionTreeHMM
-from skmotion.tree import _batch
+from skmotion.tree import MotionTreeHMM, _batch
 from skmotion.utils import _parallel
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
@@ -44,35 +41,58 @@ def small_tasks(monkeypatch):
     monkeypatch.setattr(_interval_neighbors, "_LEAVES_PER_TASK", 1)
     monkeypatch.setattr(_psi, "_ROWS", 2)
     original = _batch.length_groups
-    monkeypatch.setattr(_batch, "length_groups", lambda lengths, n_graphs: original(lengths, n_graphs, budget=400))
+    monkeypatch.setattr(
+        _batch, "length_groups", lambda lengths, n_graphs: original(lengths, n_graphs, budget=400)
+    )
     monkeypatch.setattr(RecordingParallel, "calls", [])
     monkeypatch.setattr(_parallel, "Parallel", RecordingParallel)
     return RecordingParallel.calls
 
 
 def _joint_angles():
-    data = make_motions(n_clips_per_class=2, classes=["walk", "squat", "wave"], duration=(0.6, 1.0), random_state=0)
+    data = make_motions(
+        n_clips_per_class=2, classes=["walk", "squat", "wave"], duration=(0.6, 1.0), random_state=0
+    )
     return data.clips, data.target
 
 
 CASES = {
     "MotionTreeHMM": (
-        MotionTreeHMM(max_depth=3, min_samples_leaf=4), _motions,
-        lambda est, X: {"decode": _as_list(est.decode(X)), "windows": _as_list(est.predict_proba_windows(X, 20, 7))},
+        MotionTreeHMM(max_depth=3, min_samples_leaf=4),
+        _motions,
+        lambda est, X: {
+            "decode": _as_list(est.decode(X)),
+            "windows": _as_list(est.predict_proba_windows(X, 20, 7)),
+        },
     ),
     "MotionTreeHMM-clip-graphs": (
-        MotionTreeHMM(max_depth=3, min_samples_leaf=4, graph="clip", node_prior="graph"), _motions, None,
+        MotionTreeHMM(max_depth=3, min_samples_leaf=4, graph="clip", node_prior="graph"),
+        _motions,
+        None,
     ),
     "IntervalIndexNeighbors": (
-        IntervalIndexNeighbors(n_levels=3, n_neighbors=2, epsilon=0.5), _motions,
+        IntervalIndexNeighbors(n_levels=3, n_neighbors=2, epsilon=0.5),
+        _motions,
         lambda est, X: {"kneighbors": list(est.kneighbors(X)), "self": list(est.kneighbors())},
     ),
-    "SVDFeatureExtractor": (SVDFeatureExtractor(n_components=3, weighting="first_two"), _motions, None),
-    "EigenMovementPCA": (
-        EigenMovementPCA(n_components=3, n_samples=20), lambda: (stroke_clips(9), None),
-        lambda est, X: {"reconstruct": _as_list(est.reconstruct(X)), "segment": _as_list(est.segment(X))},
+    "SVDFeatureExtractor": (
+        SVDFeatureExtractor(n_components=3, weighting="first_two"),
+        _motions,
+        None,
     ),
-    "VirtualMarkerTransform": (VirtualMarkerTransform(humanoid_skeleton(), frame_rate=30.0), _joint_angles, None),
+    "EigenMovementPCA": (
+        EigenMovementPCA(n_components=3, n_samples=20),
+        lambda: (stroke_clips(9), None),
+        lambda est, X: {
+            "reconstruct": _as_list(est.reconstruct(X)),
+            "segment": _as_list(est.segment(X)),
+        },
+    ),
+    "VirtualMarkerTransform": (
+        VirtualMarkerTransform(humanoid_skeleton(), frame_rate=30.0),
+        _joint_angles,
+        None,
+    ),
     "LowPassFilter": (LowPassFilter(order=4), _motions, None),
 }
 
@@ -107,6 +127,10 @@ def test_pairwise_psi_n_jobs_bit_identical(small_tasks):
 
 
 def test_every_estimator_with_n_jobs_has_a_case():
-    with_jobs = {n for n, cls in skmotion_estimators().items() if "n_jobs" in inspect.signature(cls).parameters}
+    with_jobs = {
+        n
+        for n, cls in skmotion_estimators().items()
+        if "n_jobs" in inspect.signature(cls).parameters
+    }
     missing = with_jobs - {name.split("-")[0] for name in CASES}
     assert not missing, f"add an n_jobs case to tests/test_n_jobs.py for {sorted(missing)}"

@@ -16,19 +16,28 @@ from skmotion.control import KMeansPrimitiveController
 from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
 from skmotion.neighbors import IntervalIndexNeighbors
-from skmotion.preprocessing import FlattenClips, LowPassFilter, ResampleClips, VirtualMarkerTransform
+from skmotion.preprocessing import (
+    FlattenClips,
+    LowPassFilter,
+    ResampleClips,
+    VirtualMarkerTransform,
+)
 from skmotion.tree import MotionTreeHMM
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
 
 
 def _motions():
-    data = make_motions(n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1)
+    data = make_motions(
+        n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1
+    )
     return [c[:, 6:] for c in data.clips], data.target_names[data.target]
 
 
 def _joint_angles():
-    data = make_motions(n_clips_per_class=2, classes=["walk", "squat"], duration=(0.6, 1.0), random_state=0)
+    data = make_motions(
+        n_clips_per_class=2, classes=["walk", "squat"], duration=(0.6, 1.0), random_state=0
+    )
     return data.clips, data.target
 
 
@@ -52,18 +61,42 @@ def _extra(name, *args, **kwargs):
 
 # Estimator, data, and the methods beyond the common ones (predict, transform, score...).
 CASES = {
-    "MotionTreeHMM": (MotionTreeHMM(max_depth=3, min_samples_leaf=4), _motions,
-                      {"decode": _extra("decode"),
-                       "predict_next": lambda est, X: [est.predict_next(X, 2).probabilities]}),
-    "IntervalIndexNeighbors": (IntervalIndexNeighbors(n_levels=3, n_neighbors=2), _motions,
-                               {"kneighbors": lambda est, X: list(est.kneighbors(X)),
-                                "candidates": lambda est, X: [np.concatenate(est.candidates(X))]}),
-    "SVDFeatureExtractor": (SVDFeatureExtractor(n_components=3, weighting="first_two"), _motions, {}),
-    "EigenMovementPCA": (EigenMovementPCA(n_components=3, n_samples=20), _strokes,
-                         {"reconstruct": _extra("reconstruct"), "segment": _extra("segment")}),
-    "KMeansPrimitiveController": (KMeansPrimitiveController(4, n_init=2, random_state=0), _codes,
-                                  {"quantize": _extra("quantize")}),
-    "VirtualMarkerTransform": (VirtualMarkerTransform(humanoid_skeleton(), frame_rate=30.0), _joint_angles, {}),
+    "MotionTreeHMM": (
+        MotionTreeHMM(max_depth=3, min_samples_leaf=4),
+        _motions,
+        {
+            "decode": _extra("decode"),
+            "predict_next": lambda est, X: [est.predict_next(X, 2).probabilities],
+        },
+    ),
+    "IntervalIndexNeighbors": (
+        IntervalIndexNeighbors(n_levels=3, n_neighbors=2),
+        _motions,
+        {
+            "kneighbors": lambda est, X: list(est.kneighbors(X)),
+            "candidates": lambda est, X: [np.concatenate(est.candidates(X))],
+        },
+    ),
+    "SVDFeatureExtractor": (
+        SVDFeatureExtractor(n_components=3, weighting="first_two"),
+        _motions,
+        {},
+    ),
+    "EigenMovementPCA": (
+        EigenMovementPCA(n_components=3, n_samples=20),
+        _strokes,
+        {"reconstruct": _extra("reconstruct"), "segment": _extra("segment")},
+    ),
+    "KMeansPrimitiveController": (
+        KMeansPrimitiveController(4, n_init=2, random_state=0),
+        _codes,
+        {"quantize": _extra("quantize")},
+    ),
+    "VirtualMarkerTransform": (
+        VirtualMarkerTransform(humanoid_skeleton(), frame_rate=30.0),
+        _joint_angles,
+        {},
+    ),
     "ResampleClips": (ResampleClips(n_frames=7, kind="cubic"), _motions, {}),
     "FlattenClips": (FlattenClips(), _equal_length, {}),
     "LowPassFilter": (LowPassFilter(order=4), _motions, {}),
@@ -91,14 +124,18 @@ def _fitted(name):
 
 def _results(estimator, X, y, extra):
     results = outputs(estimator, X, y)
-    results.update({method: [np.asarray(a) for a in get(estimator, X)] for method, get in extra.items()})
+    results.update(
+        {method: [np.asarray(a) for a in get(estimator, X)] for method, get in extra.items()}
+    )
     return results
 
 
 def test_every_estimator_is_versioned_and_has_a_case():
     estimators = skmotion_estimators()
     unversioned = [n for n, cls in estimators.items() if not issubclass(cls, VersionedStateMixin)]
-    assert not unversioned, f"estimators without VersionedStateMixin (derive from ClipEstimatorMixin): {unversioned}"
+    assert not unversioned, (
+        f"estimators without VersionedStateMixin (derive from ClipEstimatorMixin): {unversioned}"
+    )
     missing = sorted(set(estimators) - set(CASES))
     assert not missing, f"add a persistence case to tests/test_persistence.py for {missing}"
 
@@ -108,11 +145,17 @@ def test_pickle_and_joblib_round_trip(name, tmp_path):
     estimator, X, y, extra = _fitted(name)
     expected = _results(estimator, X, y, extra)
     restored = pickle.loads(pickle.dumps(estimator))
-    assert_outputs_equal(expected, _results(restored, X, y, extra), exact=True, context=f"{name} after pickle")
+    assert_outputs_equal(
+        expected, _results(restored, X, y, extra), exact=True, context=f"{name} after pickle"
+    )
     joblib.dump(estimator, tmp_path / "model.joblib", compress=3)
     loaded = joblib.load(tmp_path / "model.joblib")
-    assert_outputs_equal(expected, _results(loaded, X, y, extra), exact=True, context=f"{name} after joblib")
-    assert "_skmotion_version" not in vars(loaded), "the version belongs to the pickle, not to the object"
+    assert_outputs_equal(
+        expected, _results(loaded, X, y, extra), exact=True, context=f"{name} after joblib"
+    )
+    assert "_skmotion_version" not in vars(loaded), (
+        "the version belongs to the pickle, not to the object"
+    )
 
 
 def test_data_structures_round_trip():
@@ -174,7 +217,9 @@ def test_running_a_newer_minor_version_refuses_and_a_patch_release_loads(monkeyp
     monkeypatch.setattr(skmotion, "__version__", f"{major}.{minor}.99")
     assert_outputs_equal(outputs(estimator, X), outputs(pickle.loads(data), X), exact=True)
     monkeypatch.setattr(skmotion, "__version__", f"{major}.{int(minor) + 1}.0")
-    with pytest.raises(IncompatibleVersionError, match=f"LowPassFilter was saved by skmotion {major}.{minor}"):
+    with pytest.raises(
+        IncompatibleVersionError, match=f"LowPassFilter was saved by skmotion {major}.{minor}"
+    ):
         pickle.loads(data)
 
 

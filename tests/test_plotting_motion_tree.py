@@ -14,7 +14,9 @@ plotting = pytest.importorskip("skmotion.plotting")
 @pytest.fixture(scope="module")
 def model():
     data = make_motions(n_clips_per_class=3, classes=["walk", "jump", "squat"], random_state=0)
-    return MotionTreeHMM(max_depth=4, split="median").fit([c[:, 6:] for c in data.clips], data.target)
+    return MotionTreeHMM(max_depth=4, split="median").fit(
+        [c[:, 6:] for c in data.clips], data.target
+    )
 
 
 def test_nodes_sit_at_their_projected_means(model):
@@ -26,7 +28,9 @@ def test_nodes_sit_at_their_projected_means(model):
 
 def test_edges_are_the_likely_transitions(model):
     graphs, layer = model.graphs_, 4
-    ax = plotting.plot_motion_tree_layer(model.tree_, graphs, layer=layer, graph=1, min_probability=0.1)
+    ax = plotting.plot_motion_tree_layer(
+        model.tree_, graphs, layer=layer, graph=1, min_probability=0.1
+    )
     P = graphs.matrix(layer, 1)
     seen = graphs.counts(layer, 1).toarray() > 0
     expected = int(((P >= 0.1) & seen & ~np.eye(len(P), dtype=bool)).sum())

@@ -24,7 +24,11 @@ def _message(call):
 def _truncated_bvh(motion, folder):
     """The first 40 frames of a motion written as BVH, then cut in the middle of the 20th frame line."""
     path = Path(folder) / "walk.bvh"
-    write_bvh(Motion(motion.skeleton, motion.channels[:40], frame_rate=motion.frame_rate), path, precision=4)
+    write_bvh(
+        Motion(motion.skeleton, motion.channels[:40], frame_rate=motion.frame_rate),
+        path,
+        precision=4,
+    )
     lines = path.read_text().splitlines(keepends=True)
     first = next(k for k, line in enumerate(lines) if line.startswith("Frame Time")) + 1
     cut = first + min(19, len(lines) - first - 1)  # a short clip is cut in its last line
@@ -35,7 +39,9 @@ def _truncated_bvh(motion, folder):
 def run(context):
     data = context.data
     # One clip of the data (synthetic, or the first file of --data FOLDER) made bad in each way.
-    motion = (data.get("motions") or as_motions(data.clips[:1], data.skeletons[:1], data.frame_rate))[0]
+    motion = (
+        data.get("motions") or as_motions(data.clips[:1], data.skeletons[:1], data.frame_rate)
+    )[0]
     clip = motion.channels
     with_nan = [clip.copy() for _ in range(4)]
     with_nan[3][min(17, len(clip) - 1), min(8, clip.shape[1] - 1)] = np.nan
@@ -49,5 +55,9 @@ def run(context):
     with tempfile.TemporaryDirectory() as folder:
         path = _truncated_bvh(motion, folder)
         tried.append(("truncated BVH", lambda: read_bvh(path)))
-        lines = [f"{what:>20}: {_message(call).replace(str(path), path.name)}" for what, call in tried]
-    return lines + ["(every estimator and reader, with many more cases: tests/bad_input/, docs/errors.md)"]
+        lines = [
+            f"{what:>20}: {_message(call).replace(str(path), path.name)}" for what, call in tried
+        ]
+    return lines + [
+        "(every estimator and reader, with many more cases: tests/bad_input/, docs/errors.md)"
+    ]

@@ -19,7 +19,9 @@ def run(context):
     counts = np.bincount(data.target)
     subjects = np.bincount(data.groups)
     baseline = make_pipeline(ResampleClips(n_frames=32), FlattenClips(), KNeighborsClassifier(1))
-    scores = cross_val_score(baseline, data.clips, data.target, groups=data.groups, cv=GroupKFold(len(subjects)))
+    scores = cross_val_score(
+        baseline, data.clips, data.target, groups=data.groups, cv=GroupKFold(len(subjects))
+    )
     context.baseline_accuracy = scores.mean()
     sk = data.skeleton
     return [

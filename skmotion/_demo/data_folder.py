@@ -75,8 +75,12 @@ def run(context):
     ]
     n_groups = len(data.subject_names)
     if n_groups >= 2:
-        baseline = make_pipeline(ResampleClips(n_frames=32), FlattenClips(), KNeighborsClassifier(1))
-        scores = cross_val_score(baseline, clips, data.target, groups=data.groups, cv=GroupKFold(min(n_groups, 5)))
+        baseline = make_pipeline(
+            ResampleClips(n_frames=32), FlattenClips(), KNeighborsClassifier(1)
+        )
+        scores = cross_val_score(
+            baseline, clips, data.target, groups=data.groups, cv=GroupKFold(min(n_groups, 5))
+        )
         context.baseline_accuracy = scores.mean()
         lines.append(
             f"baseline, 1-NN on resampled clips, subject-wise {min(n_groups, 5)}-fold CV: "

@@ -19,15 +19,26 @@ def run(context):
     _, per_subject = np.unique(groups, return_counts=True)
     n_subjects = len(per_subject)
     if n_subjects < 3:
-        return [f"nested subject-wise CV: not run ({len(clips)} clips of {n_subjects} subject(s); needs 3)"]
+        return [
+            f"nested subject-wise CV: not run ({len(clips)} clips of {n_subjects} subject(s); needs 3)"
+        ]
     # The smallest inner training set: all clips but the two largest subjects'.
     fewest = len(clips) - np.sort(per_subject)[-2:].sum()
-    search = GridSearchCV(IntervalIndexNeighbors(n_levels=int(max(1, min(5, fewest)))), {"epsilon": [0.5, 1.0]},
-                          cv=GroupKFold(n_subjects - 1))
+    search = GridSearchCV(
+        IntervalIndexNeighbors(n_levels=int(max(1, min(5, fewest)))),
+        {"epsilon": [0.5, 1.0]},
+        cv=GroupKFold(n_subjects - 1),
+    )
     # Metadata routing sends the outer training subjects on to the inner GroupKFold.
     with sklearn.config_context(enable_metadata_routing=True):
-        result = cross_validate(search, clips, y, cv=GroupKFold(n_subjects), params={"groups": groups},
-                                return_estimator=True)
+        result = cross_validate(
+            search,
+            clips,
+            y,
+            cv=GroupKFold(n_subjects),
+            params={"groups": groups},
+            return_estimator=True,
+        )
     chosen = [est.best_params_["epsilon"] for est in result["estimator"]]
     model = result["estimator"][0].best_estimator_
     restored = pickle.loads(pickle.dumps(model))

@@ -15,7 +15,9 @@ TITLE = "Similarity search: SVD features in an interval index"
 def _search_report(index, labels):
     ids = np.arange(index.n_samples_fit_)
     candidates = index.candidates()
-    return pruning_efficiency(candidates, labels, labels, query_ids=ids), recall(candidates, labels, labels, query_ids=ids)
+    return pruning_efficiency(candidates, labels, labels, query_ids=ids), recall(
+        candidates, labels, labels, query_ids=ids
+    )
 
 
 def _us_per_query(func, n_queries, repeats):
@@ -27,9 +29,13 @@ def _us_per_query(func, n_queries, repeats):
 
 def _repeated_motions(context):
     # The paper's set-up: every motion performed several times; similar = same motion.
-    data = make_repeated_motions(n_motions_per_class=4, duration=(1.5, 2.5), random_state=context.random_state)
+    data = make_repeated_motions(
+        n_motions_per_class=4, duration=(1.5, 2.5), random_state=context.random_state
+    )
     labels = data.target
-    index = IntervalIndexNeighbors(n_levels=7, epsilon=0.8, features=SVDFeatureExtractor(weighting="first_two"))
+    index = IntervalIndexNeighbors(
+        n_levels=7, epsilon=0.8, features=SVDFeatureExtractor(weighting="first_two")
+    )
     index.fit(data.clips, labels)
     pruning, found = _search_report(index, labels)
     tree = index._tree_features
@@ -73,7 +79,9 @@ def _marker_clips(context):
     clips, labels = context.marker_clips, base.target
     n_levels = min(7, len(clips) - 1)
     if n_levels < 2 or len(np.unique(labels)) < 2:
-        return [f"the data set has {len(clips)} clips in {len(np.unique(labels))} classes: too few to index"]
+        return [
+            f"the data set has {len(clips)} clips in {len(np.unique(labels))} classes: too few to index"
+        ]
     paper = IntervalIndexNeighbors(n_levels=n_levels, epsilon=1.0).fit(clips, labels)
     pruning, found = _search_report(paper, labels)
     share, name, component = _widest_label(paper._tree_features, labels, base.get("target_names"))
@@ -81,7 +89,9 @@ def _marker_clips(context):
         n_levels=n_levels, epsilon=0.8, features=SVDFeatureExtractor(weighting="first_two")
     ).fit(clips, labels)
     tuned_pruning, tuned_found = _search_report(tuned, labels)
-    quantile = IntervalIndexNeighbors(n_levels=n_levels, epsilon=1.0, delta_quantile=0.5).fit(clips, labels)
+    quantile = IntervalIndexNeighbors(n_levels=n_levels, epsilon=1.0, delta_quantile=0.5).fit(
+        clips, labels
+    )
     quantile_pruning, quantile_found = _search_report(quantile, labels)
     context.index_pruning = tuned_pruning
     return [

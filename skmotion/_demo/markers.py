@@ -30,26 +30,35 @@ def run(context):
     context.marker_clips = clips
     n_markers = len(names) // 6
     frames = np.concatenate(clips).reshape(-1, n_markers, 6)
-    height = {name: np.median(frames[:, MARKER_NAMES.index(name), 2]) for name in ("head_top", "pelvis", "left_knee")}
+    height = {
+        name: np.median(frames[:, MARKER_NAMES.index(name), 2])
+        for name in ("head_top", "pelvis", "left_knee")
+    }
     speed = np.median(np.linalg.norm(frames[:, MARKER_NAMES.index("pelvis"), 3:5], axis=1))
     lines = [
         f"{n_markers} markers ({', '.join(MARKER_NAMES[:6])}, ...) placed by the preset of each "
         f"clip's skeleton: " + ", ".join(f"{p} {n} clips" for p, n in presets.items()),
         f"output: {len(names)} channels per frame (px py pz vx vy vz per marker; x forward, "
         "y left, z up; lengths in body heights)",
-        "median height over all frames: " + ", ".join(f"{k} {v:.2f}" for k, v in height.items())
+        "median height over all frames: "
+        + ", ".join(f"{k} {v:.2f}" for k, v in height.items())
         + f"; median horizontal pelvis speed {speed:.2f} heights/s",
     ]
     n_groups = len(np.unique(data.groups))
     if n_groups >= 2 and len(np.unique(data.target)) >= 2:
         cv = GroupKFold(min(n_groups, 5))
-        model = make_pipeline(ResampleClips(n_frames=16), FlattenClips(), StandardScaler(), RidgeClassifier())
+        model = make_pipeline(
+            ResampleClips(n_frames=16), FlattenClips(), StandardScaler(), RidgeClassifier()
+        )
         on_markers = cross_val_score(model, clips, data.target, groups=data.groups, cv=cv)
         context.marker_accuracy = on_markers.mean()
         lines.append(
             f"ridge classifier on 16 resampled frames, subject-wise {cv.get_n_splits()}-fold CV: "
             f"accuracy {on_markers.mean():.3f} +/- {on_markers.std():.3f} on markers"
-            + (f" (raw-clip 1-NN baseline {context.baseline_accuracy:.3f})" if hasattr(context, "baseline_accuracy")
-               else "")
+            + (
+                f" (raw-clip 1-NN baseline {context.baseline_accuracy:.3f})"
+                if hasattr(context, "baseline_accuracy")
+                else ""
+            )
         )
     return lines

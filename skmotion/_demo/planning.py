@@ -13,10 +13,16 @@ TITLE = "Planning: a walk to a goal on the transition graph"
 def run(context):
     # A walking database of its own: the recognition data's walks travel forward only.
     walks = make_walks(2, random_state=context.random_state)
-    X = VirtualMarkerTransform().fit_transform(as_motions(walks.clips, walks.skeletons, walks.frame_rate))
+    X = VirtualMarkerTransform().fit_transform(
+        as_motions(walks.clips, walks.skeletons, walks.frame_rate)
+    )
     model = MotionTreeHMM(max_depth=5, split="median").fit(X, walks.target)
-    transformer = VirtualMarkerTransform(walks.skeleton, frame_rate=walks.frame_rate).fit(walks.clips[:1])
-    plan = model.plan((0, 0, 0), (2.0, 1.0), frame_rate=walks.frame_rate, transformer=transformer, tolerance=0.15)
+    transformer = VirtualMarkerTransform(walks.skeleton, frame_rate=walks.frame_rate).fit(
+        walks.clips[:1]
+    )
+    plan = model.plan(
+        (0, 0, 0), (2.0, 1.0), frame_rate=walks.frame_rate, transformer=transformer, tolerance=0.15
+    )
     context.plan = plan
     x, y, heading = plan.root[-1]
     lines = [
@@ -31,12 +37,16 @@ def run(context):
         "(plan.to_motion() writes with write_bvh)",
     ]
     try:
-        model.plan((0, 0, 0), (30.0, 0.0), frame_rate=walks.frame_rate, body_size=1.6, max_frames=120)
+        model.plan(
+            (0, 0, 0), (30.0, 0.0), frame_rate=walks.frame_rate, body_size=1.6, max_frames=120
+        )
     except UnreachableGoalError as exc:
         lines.append(f"goal 30 m ahead within 120 frames: unreachable, {exc}")
     if getattr(context, "plot_dir", None):
         lines += save_figure(
-            context.plot_dir, "planned_root_path.png", lambda plotting: plotting.plot_plan(plan),
+            context.plot_dir,
+            "planned_root_path.png",
+            lambda plotting: plotting.plot_plan(plan),
             "the planned root path and the goal (Figure 13 left)",
         )
     return lines

@@ -44,7 +44,9 @@ def _classifier_lines(context, data):
     angles = [c[:, n_root:] for c in data.clips]  # without the root's travel and heading
     n_groups = len(np.unique(data.groups))
     if n_groups < 2 or len(angles) < 20:
-        return [f"classifier on primitive usage: not run ({len(angles)} clips of {n_groups} subject(s))"]
+        return [
+            f"classifier on primitive usage: not run ({len(angles)} clips of {n_groups} subject(s))"
+        ]
     model = make_pipeline(
         EigenMovementPCA(10, n_samples=30, frame_rate=data.frame_rate),
         KMeansPrimitiveController(20, n_init=3, random_state=context.random_state),
@@ -70,8 +72,14 @@ def _simulation_lines(context, clips, codes, segments, data, arm):
     lines = []
     for kp in (50.0, 400.0):
         sim = context.primitives.simulate(
-            codes[clip : clip + 1], segments[clip : clip + 1], eigenmovements=context.eigenmovements,
-            arm=arm, frame_rate=data.frame_rate, degrees=True, kp=kp, kd=kp / 10,
+            codes[clip : clip + 1],
+            segments[clip : clip + 1],
+            eigenmovements=context.eigenmovements,
+            arm=arm,
+            frame_rate=data.frame_rate,
+            degrees=True,
+            kp=kp,
+            kd=kp / 10,
         )[0]
         lines.append(
             f"arm simulation (MuJoCo, PD servos kp={kp:g} N m/rad, kd={kp / 10:g}): clip {clip}'s "
@@ -84,19 +92,27 @@ def run(context):
     data = context.data
     idx, arm = _right_arm(data)
     if idx is None:
-        return ["not run: no right arm (RightArm/RightForeArm or rhumerus/rradius rotations) in the channels"]
+        return [
+            "not run: no right arm (RightArm/RightForeArm or rhumerus/rradius rotations) in the channels"
+        ]
     clips = [np.degrees(c[:, idx]) for c in data.clips]  # the paper's 4 DOF, in degrees
     names = [data.feature_names[i] for i in idx]
     # The paper's order-10 filter needs 34 frames; shorter clips are segmented unfiltered.
     order = 10 if min(len(c) for c in clips) >= filter_min_frames(10, 0.25) else None
-    n_segments = sum(len(segment_clip(c, filter_order=order, min_movement=_MIN_MOVEMENT)) for c in clips)
+    n_segments = sum(
+        len(segment_clip(c, filter_order=order, min_movement=_MIN_MOVEMENT)) for c in clips
+    )
     if n_segments < 2:
         return [f"not run: the right arm's {len(clips)} clips hold {n_segments} segment(s)"]
 
-    pca = EigenMovementPCA(min(10, n_segments), filter_order=order, min_movement=_MIN_MOVEMENT).fit(clips)
+    pca = EigenMovementPCA(min(10, n_segments), filter_order=order, min_movement=_MIN_MOVEMENT).fit(
+        clips
+    )
     codes, segments = pca.transform(clips), pca.segment(clips)
     n_clusters = min(20, n_segments)
-    controller = KMeansPrimitiveController(n_clusters, n_init=3, random_state=context.random_state).fit(codes)
+    controller = KMeansPrimitiveController(
+        n_clusters, n_init=3, random_state=context.random_state
+    ).fit(codes)
     context.eigenmovements, context.primitives = pca, controller
     n_features = pca.components_.shape[1]
     total = pca.projection_mse_ + controller.clustering_mse_

@@ -10,7 +10,10 @@ TITLE = "Recognition: the motion database (MotionTreeHMM)"
 
 def _confusion(names, truth, predicted):
     width = max(len(n) for n in names)
-    lines = ["confusion (rows: true, columns: predicted):", " " * (width + 2) + " ".join(n[:5].rjust(5) for n in names)]
+    lines = [
+        "confusion (rows: true, columns: predicted):",
+        " " * (width + 2) + " ".join(n[:5].rjust(5) for n in names),
+    ]
     for name in names:
         row = [int(np.sum((truth == name) & (predicted == other))) for other in names]
         lines.append(f"  {name.rjust(width)} " + " ".join(str(v).rjust(5) for v in row))
@@ -29,7 +32,7 @@ def _split(data, names):
     for value in np.unique(names):
         members = np.flatnonzero(names == value)
         rank[members] = np.arange(len(members))
-    test = (rank % 3 == 2)
+    test = rank % 3 == 2
     return np.flatnonzero(~test), np.flatnonzero(test), "every third clip of each class"
 
 
@@ -41,7 +44,9 @@ def run(context):
     names = np.asarray(data.target_names)[data.target]
     train, test, held_out = _split(data, names)
     if len(np.unique(names[train])) < 2 or len(test) == 0:
-        return [f"{len(clips)} clips in {len(np.unique(names))} classes: too few to train and test a classifier"]
+        return [
+            f"{len(clips)} clips in {len(np.unique(names))} classes: too few to train and test a classifier"
+        ]
     model = MotionTreeHMM().fit([clips[i] for i in train], names[train])
     context.motion_tree = model
     predicted = model.predict([clips[i] for i in test])
@@ -56,21 +61,27 @@ def run(context):
         f"MotionTreeHMM (defaults: minimum-error splits, max_depth={model.max_depth}, "
         f"min_samples_leaf={model.min_samples_leaf}) on {n_markers} virtual markers ({clip.shape[1]} channels)",
         f"trained on {len(train)} clips, tested on {held_out} ({len(test)} clips): accuracy {accuracy:.3f}",
-        *_confusion([str(c) for c in model.classes_], names[test].astype(str), predicted.astype(str)),
+        *_confusion(
+            [str(c) for c in model.classes_], names[test].astype(str), predicted.astype(str)
+        ),
         f"tree: {int(tree.count[0]):,} frames, {tree.n_layers} layers, {tree.n_tree_nodes} nodes, "
         f"{int(tree.n_nodes[-1])} in the bottom layer",
         "nodes per layer: " + " ".join(str(int(n)) for n in tree.n_nodes),
         f"state estimation, first {half_second} frames of a test {names[test[0]]}: bottom-layer nodes "
-        + " ".join(str(int(n)) for n in states[-6:]) + " (last six)",
+        + " ".join(str(int(n)) for n in states[-6:])
+        + " (last six)",
         f"prediction 5 frames ahead: node {int(ahead.nodes[0, 0])} with probability {ahead.probabilities[0, 0]:.2f}",
     ]
     plot_dir = getattr(context, "plot_dir", None)
     if plot_dir:
         lines += save_figure(
-            plot_dir, "motion_tree_layers.png",
+            plot_dir,
+            "motion_tree_layers.png",
             lambda plotting: plotting.plot_motion_tree_layers(model.tree_, model.global_graph_),
             "nodes on the first principal axes with the global transition graph",
         )
     else:
-        lines.append("(skmotion demo --plots DIR draws the tree's nodes and transition graphs, as the paper's Figures 3-5)")
+        lines.append(
+            "(skmotion demo --plots DIR draws the tree's nodes and transition graphs, as the paper's Figures 3-5)"
+        )
     return lines

@@ -78,8 +78,15 @@ class ArmModel:
 
     def __post_init__(self):
         links = np.asarray(self.links, dtype=float)
-        if links.ndim != 2 or links.shape[1] != 3 or len(links) == 0 or not np.isfinite(links).all():
-            raise ValueError(f"links must be a finite array of shape (n_links, 3); got {links.shape}.")
+        if (
+            links.ndim != 2
+            or links.shape[1] != 3
+            or len(links) == 0
+            or not np.isfinite(links).all()
+        ):
+            raise ValueError(
+                f"links must be a finite array of shape (n_links, 3); got {links.shape}."
+            )
         if (np.linalg.norm(links, axis=1) <= 0).any():
             raise ValueError("Every link must have a positive length.")
         hinges = tuple(tuple(_readonly(a) for a in h) for h in self.hinges)
@@ -88,7 +95,9 @@ class ArmModel:
         for i, h in enumerate(hinges):
             for a in h:
                 if a.shape != (3,) or abs(np.linalg.norm(a) - 1) > 1e-9:
-                    raise ValueError(f"hinge axes of link {i} must be unit 3-vectors; got {a.tolist()}.")
+                    raise ValueError(
+                        f"hinge axes of link {i} must be unit 3-vectors; got {a.tolist()}."
+                    )
         radii = np.broadcast_to(np.asarray(self.radii, dtype=float), (len(links),))
         if not (radii > 0).all():
             raise ValueError(f"radii must be positive; got {radii.tolist()}.")
@@ -98,7 +107,11 @@ class ArmModel:
         if up not in _UP:
             raise ValueError(f"up_axis must be one of {sorted(_UP)}; got {self.up_axis!r}.")
         n_dof = sum(len(h) for h in hinges)
-        names = tuple(f"q{k}" for k in range(n_dof)) if self.dof_names is None else tuple(self.dof_names)
+        names = (
+            tuple(f"q{k}" for k in range(n_dof))
+            if self.dof_names is None
+            else tuple(self.dof_names)
+        )
         if len(names) != n_dof:
             raise ValueError(f"dof_names has {len(names)} names for {n_dof} hinges.")
         object.__setattr__(self, "links", _readonly(links))
@@ -139,7 +152,9 @@ class ArmModel:
         arm : ArmModel
         """
         if skeleton.meters_per_unit is None:
-            raise ValueError("The skeleton's meters_per_unit is unknown; set it to build an arm in metres.")
+            raise ValueError(
+                "The skeleton's meters_per_unit is unknown; set it to build an arm in metres."
+            )
         if len(dofs) != len(joints):
             raise ValueError(f"dofs has {len(dofs)} entries for {len(joints)} joints.")
         rest = forward_kinematics(skeleton, np.zeros((1, skeleton.n_channels))).positions[0]
@@ -149,7 +164,9 @@ class ArmModel:
         for joint, j, wanted in zip(joints, chain, dofs):
             wanted = str(wanted).upper()
             order = skeleton.rotation_orders[j]
-            unknown = [a for a in wanted if a not in order or f"{a}rotation" not in skeleton.channels[j]]
+            unknown = [
+                a for a in wanted if a not in order or f"{a}rotation" not in skeleton.channels[j]
+            ]
             if unknown:
                 raise ValueError(f"Joint {joint!r} has no rotation channel about {unknown}.")
             frame = np.eye(3) if skeleton.axes is None else skeleton.axes[j]

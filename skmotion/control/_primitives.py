@@ -125,7 +125,9 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
     # A clip without segments has no codes: empty code arrays are valid input.
     _motion_tags = MotionTags(output_kind="table", min_frames=0)
 
-    def __init__(self, n_clusters=30, *, n_init=10, max_iter=300, tol=1e-4, normalize=True, random_state=None):
+    def __init__(
+        self, n_clusters=30, *, n_init=10, max_iter=300, tol=1e-4, normalize=True, random_state=None
+    ):
         self.n_clusters = n_clusters
         self.n_init = n_init
         self.max_iter = max_iter
@@ -331,7 +333,10 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
     def _execute(target, arm, frame_rate, degrees, servo):
         target = np.deg2rad(target) if degrees else target
         n_frames = len(target)
-        fields = {name: np.full((n_frames, arm.n_dof), np.nan) for name in ("angles", "velocities", "torques")}
+        fields = {
+            name: np.full((n_frames, arm.n_dof), np.nan)
+            for name in ("angles", "velocities", "torques")
+        }
         tip = np.full((n_frames, 3), np.nan)
         for start, stop in _covered_runs(~np.isnan(target).any(axis=1)):
             if stop - start < 2:

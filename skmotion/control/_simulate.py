@@ -13,8 +13,7 @@ def _import_mujoco():
         import mujoco
     except ImportError as exc:  # pragma: no cover - exercised only without the extra
         raise ImportError(
-            "Simulating the arm needs MuJoCo, an optional dependency: "
-            'pip install "skmotion[sim]"'
+            'Simulating the arm needs MuJoCo, an optional dependency: pip install "skmotion[sim]"'
         ) from exc
     return mujoco
 
@@ -74,7 +73,9 @@ class ArmSimulation:
 def _gains(value, n_dof, name):
     gains = np.asarray(value, dtype=float)
     if gains.ndim > 1 or (gains.ndim == 1 and len(gains) != n_dof):
-        raise ValueError(f"{name} must be a number or one number per joint ({n_dof}); got shape {gains.shape}.")
+        raise ValueError(
+            f"{name} must be a number or one number per joint ({n_dof}); got shape {gains.shape}."
+        )
     if not (np.isfinite(gains).all() and (gains >= 0).all()):
         raise ValueError(f"{name} must be finite and non-negative; got {gains.tolist()}.")
     return np.broadcast_to(gains, (n_dof,))
@@ -140,9 +141,13 @@ def simulate_arm(trajectory, *, arm, frame_rate, kp=200.0, kd=20.0, timestep=0.0
         )
     if not np.isfinite(q_target).all():
         frame, dof = np.argwhere(~np.isfinite(q_target))[0]
-        raise ValueError(f"trajectory is not finite at frame {frame}, joint {arm.dof_names[dof]!r}.")
+        raise ValueError(
+            f"trajectory is not finite at frame {frame}, joint {arm.dof_names[dof]!r}."
+        )
     if not frame_rate > 0 or not timestep > 0:
-        raise ValueError(f"frame_rate and timestep must be positive; got {frame_rate!r}, {timestep!r}.")
+        raise ValueError(
+            f"frame_rate and timestep must be positive; got {frame_rate!r}, {timestep!r}."
+        )
     kp, kd = _gains(kp, arm.n_dof, "kp"), _gains(kd, arm.n_dof, "kd")
 
     steps_per_frame = max(1, int(np.ceil(1.0 / (frame_rate * timestep) - 1e-9)))

@@ -103,24 +103,32 @@ def fetch_cmu_mocap(subjects, *, trials=None, data_home=None, index=None, timeou
         folder.mkdir(parents=True, exist_ok=True)
         asf = folder / f"{name}.asf"
         if not asf.is_file() and not _download(f"{CMU_URL}/{name}/{name}.asf", asf, timeout):
-            raise ValueError(f"CMU has no subject {subject} ({CMU_URL}/{name}/{name}.asf not found).")
+            raise ValueError(
+                f"CMU has no subject {subject} ({CMU_URL}/{name}/{name}.asf not found)."
+            )
         wanted = _subject_trials(subject, trials, index)
         if wanted is None:
             if (folder / _COMPLETE).is_file():
                 continue
             for trial in range(1, _MAX_TRIALS + 1):
                 amc = folder / f"{name}_{trial:02d}.amc"
-                if not amc.is_file() and not _download(f"{CMU_URL}/{name}/{amc.name}", amc, timeout):
+                if not amc.is_file() and not _download(
+                    f"{CMU_URL}/{name}/{amc.name}", amc, timeout
+                ):
                     break
             (folder / _COMPLETE).write_text("every trial of this subject is cached\n")
             continue
         for trial in wanted:
             amc = folder / f"{name}_{trial:02d}.amc"
             if not amc.is_file() and not _download(f"{CMU_URL}/{name}/{amc.name}", amc, timeout):
-                raise ValueError(f"CMU has no trial {name}_{trial:02d} ({CMU_URL}/{name}/{amc.name} not found).")
+                raise ValueError(
+                    f"CMU has no trial {name}_{trial:02d} ({CMU_URL}/{name}/{amc.name} not found)."
+                )
     data = load_cmu_asfamc(root, index, subjects=subjects)
     if trials is not None:
-        keep = np.isin([int(t.split("_")[1]) for t in data.trials], np.atleast_1d(trials).astype(int))
+        keep = np.isin(
+            [int(t.split("_")[1]) for t in data.trials], np.atleast_1d(trials).astype(int)
+        )
         data = _select(data, np.flatnonzero(keep))
     return data
 

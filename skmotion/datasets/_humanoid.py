@@ -35,7 +35,6 @@ for _side, _x in (("Left", 1.0), ("Right", -1.0)):
     ]
 
 
-
 def humanoid_skeleton(scale=1.0):
     """The built-in 26-joint humanoid (21 with channels, 5 end sites), in metres.
 

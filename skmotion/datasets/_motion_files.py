@@ -105,7 +105,11 @@ def _read_amc_folder(folder, index):
             skeletons[asf] = read_asf(asf)
         trial = _trial_id(amc.stem)
         rate = 120.0
-        if index is not None and trial in index.index and np.isfinite(index.loc[trial, "frame_rate"]):
+        if (
+            index is not None
+            and trial in index.index
+            and np.isfinite(index.loc[trial, "frame_rate"])
+        ):
             rate = float(index.loc[trial, "frame_rate"])
         out.append((read_amc(amc, skeletons[asf], frame_rate=rate), amc))
     return out
@@ -116,7 +120,9 @@ def _bunch(entries, root, index, descr):
     motions = [m for m, _ in entries]
     paths = [p for _, p in entries]
     trials = [_trial_id(p.stem) for p in paths]
-    folders = [p.parent.relative_to(root).as_posix() if p.parent != root else root.name for p in paths]
+    folders = [
+        p.parent.relative_to(root).as_posix() if p.parent != root else root.name for p in paths
+    ]
     known = [index is not None and t in index.index for t in trials]
     descriptions = [index.loc[t, "description"] if k else "" for t, k in zip(trials, known)]
     labels = [_short_label(d) if k and d else f for d, k, f in zip(descriptions, known, folders)]
@@ -203,7 +209,9 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None):
         entries += _read_amc_folder(sub, index)
     if not entries:
         raise FileNotFoundError(f"No .amc trials under {folder} (expected one folder per subject).")
-    return _bunch(entries, folder, index, "CMU Graphics Lab Motion Capture Database, Acclaim ASF/AMC.")
+    return _bunch(
+        entries, folder, index, "CMU Graphics Lab Motion Capture Database, Acclaim ASF/AMC."
+    )
 
 
 def load_bvh_folder(folder, *, up_axis=None):

@@ -109,7 +109,9 @@ def make_repeated_motions(
     ['walk', 'walk', 'walk', 'walk', 'walk', 'walk']
     """
     if len(duration) != 2 or not 0 < duration[0] <= duration[1]:
-        raise ValueError(f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}.")
+        raise ValueError(
+            f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}."
+        )
     rng = check_random_state(random_state)
     total = n_repeats * float(duration[1])
     source = make_motions(
@@ -132,7 +134,9 @@ def make_repeated_motions(
             channels = _pelvis_relative_positions(source.skeletons[motion], channels)
         else:
             channels = channels[:, _ROOT_CHANNELS:]
-        lengths = np.maximum(1, np.round(rng.uniform(*duration, size=n_repeats) * frame_rate).astype(int))
+        lengths = np.maximum(
+            1, np.round(rng.uniform(*duration, size=n_repeats) * frame_rate).astype(int)
+        )
         starts = np.r_[0, np.cumsum(lengths)[:-1]]
         clips += [np.ascontiguousarray(channels[s : s + n]) for s, n in zip(starts, lengths)]
         target += [motion] * n_repeats

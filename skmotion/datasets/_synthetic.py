@@ -100,7 +100,9 @@ def _gait(pose, phi, p, *, hip, knee, stance, ankle, arm, elbow, lean):
     for side, shift in (("Left", 0.0), ("Right", np.pi)):
         ph = phi + shift
         pose.hip(side, hip[0] + hip[1] * amp * np.sin(ph), abduct=2.0)
-        pose.knee(side, knee[0] + knee[1] * amp * _bump(ph, knee[2], 0.75) + stance * _bump(ph, 1.9, 0.4))
+        pose.knee(
+            side, knee[0] + knee[1] * amp * _bump(ph, knee[2], 0.75) + stance * _bump(ph, 1.9, 0.4)
+        )
         pose.ankle(side, ankle * np.sin(ph - 0.8))
         pose.shoulder(side, -arm * amp * np.sin(ph), abduct=p["carry"])
         pose.elbow(side, elbow[0] + elbow[1] * (1 - np.sin(ph)) / 2)
@@ -111,8 +113,18 @@ def _gait(pose, phi, p, *, hip, knee, stance, ankle, arm, elbow, lean):
 def _walk(pose, t, p):
     f = 0.95 * p["tempo"]
     phi = _TWO_PI * f * t + p["phase"]
-    _gait(pose, phi, p, hip=(4, 22), knee=(5, 55, -0.35), stance=12, ankle=8,
-          arm=16, elbow=(12, 10), lean=2)
+    _gait(
+        pose,
+        phi,
+        p,
+        hip=(4, 22),
+        knee=(5, 55, -0.35),
+        stance=12,
+        ankle=8,
+        arm=16,
+        elbow=(12, 10),
+        lean=2,
+    )
     speed = 1.4 * p["scale"] * np.sqrt(p["amp"]) * f * (1 + 0.05 * np.cos(2 * phi))
     return speed, np.zeros_like(t), np.full_like(t, 2.0)
 
@@ -120,8 +132,18 @@ def _walk(pose, t, p):
 def _jog(pose, t, p):
     f = 1.4 * p["tempo"]
     phi = _TWO_PI * f * t + p["phase"]
-    _gait(pose, phi, p, hip=(8, 32), knee=(15, 85, -0.5), stance=20, ankle=15,
-          arm=28, elbow=(80, 15), lean=8)
+    _gait(
+        pose,
+        phi,
+        p,
+        hip=(8, 32),
+        knee=(15, 85, -0.5),
+        stance=20,
+        ankle=15,
+        arm=28,
+        elbow=(80, 15),
+        lean=8,
+    )
     speed = 1.9 * p["scale"] * np.sqrt(p["amp"]) * f * (1 + 0.08 * np.cos(2 * phi))
     flight = 0.05 * p["scale"] * p["amp"] * _bump(2 * phi, np.pi / 2, 0.6)
     return speed, flight, np.full_like(t, 5.0)
@@ -130,10 +152,22 @@ def _jog(pose, t, p):
 def _jump(pose, t, p):
     f = p["tempo"] / 1.3
     u = f * t + p["phase"] / _TWO_PI
-    depth = p["amp"] * _keyframes(u, [(0, 0), (0.12, 0.25), (0.30, 1.0), (0.40, 0.0),
-                                      (0.52, 0.12), (0.64, 0.0), (0.72, 0.7), (0.86, 0.2)])
-    arms = p["amp"] * _keyframes(u, [(0, 0), (0.30, -45), (0.40, 120), (0.55, 150),
-                                     (0.64, 90), (0.75, 10)])
+    depth = p["amp"] * _keyframes(
+        u,
+        [
+            (0, 0),
+            (0.12, 0.25),
+            (0.30, 1.0),
+            (0.40, 0.0),
+            (0.52, 0.12),
+            (0.64, 0.0),
+            (0.72, 0.7),
+            (0.86, 0.2),
+        ],
+    )
+    arms = p["amp"] * _keyframes(
+        u, [(0, 0), (0.30, -45), (0.40, 120), (0.55, 150), (0.64, 90), (0.75, 10)]
+    )
     for side in ("Left", "Right"):
         pose.hip(side, 75 * depth)
         pose.knee(side, 105 * depth)
@@ -155,8 +189,13 @@ def _kick(pose, t, p):
     u = f * t + p["phase"] / _TWO_PI
     kick, support = p["side"], _other(p["side"])
     amp = p["amp"]
-    pose.hip(kick, amp * _keyframes(u, [(0, 0), (0.25, 5), (0.38, 60), (0.48, 80), (0.60, 30), (0.75, 0)]))
-    pose.knee(kick, _keyframes(u, [(0, 5), (0.25, 10), (0.38, 95), (0.48, 10), (0.60, 50), (0.75, 10)]))
+    pose.hip(
+        kick,
+        amp * _keyframes(u, [(0, 0), (0.25, 5), (0.38, 60), (0.48, 80), (0.60, 30), (0.75, 0)]),
+    )
+    pose.knee(
+        kick, _keyframes(u, [(0, 5), (0.25, 10), (0.38, 95), (0.48, 10), (0.60, 50), (0.75, 10)])
+    )
     pose.ankle(kick, _keyframes(u, [(0, 0), (0.38, 5), (0.48, -20), (0.60, 0)]))
     strike = _keyframes(u, [(0, 0), (0.25, 0.1), (0.45, 1.0), (0.60, 0.5), (0.75, 0.0)])
     pose.hip(support, 8 + 4 * strike)
@@ -175,8 +214,14 @@ def _wave(pose, t, p):
     raised = _smoothstep((t - p["onset"]) / 0.6)
     arm, rest = p["side"], _other(p["side"])
     swing = np.sin(omega * t + p["phase"])
-    pose.shoulder(arm, 20 * raised, abduct=raised * (100 + 10 * p["amp"] * swing) + (1 - raised) * p["carry"])
-    pose.elbow(arm, 10 * raised, sideways=raised * (55 + 30 * p["amp"] * np.sin(omega * t + p["phase"] + 0.3)))
+    pose.shoulder(
+        arm, 20 * raised, abduct=raised * (100 + 10 * p["amp"] * swing) + (1 - raised) * p["carry"]
+    )
+    pose.elbow(
+        arm,
+        10 * raised,
+        sideways=raised * (55 + 30 * p["amp"] * np.sin(omega * t + p["phase"] + 0.3)),
+    )
     pose.shoulder(rest, 0.0, abduct=p["carry"])
     pose.elbow(rest, 10.0)
     sway = np.sin(0.5 * omega * t)
@@ -250,7 +295,9 @@ def _root_channels(skeleton, pose, t, p, speed, flight, pitch):
     channels[:, cols["Yposition"]] = 0.0
     # Put the lowest point of the feet on the floor, then add any flight.
     fk = forward_kinematics(skeleton, channels)
-    idx = [skeleton.joint_index(j) for j in ("LeftFoot", "RightFoot", "LeftToe_end", "RightToe_end")]
+    idx = [
+        skeleton.joint_index(j) for j in ("LeftFoot", "RightFoot", "LeftToe_end", "RightToe_end")
+    ]
     heights = fk.positions[:, idx, 1]
     heights[:, :2] -= 0.08 * p["scale"]  # the sole lies below the ankle joint
     channels[:, cols["Yposition"]] = -heights.min(axis=1) + flight
@@ -265,7 +312,9 @@ def _subject_style(rng):
         "lean": rng.normal(0.0, 3.0),
         "carry": rng.normal(8.0, 3.0),
         "left_handed": rng.uniform() < 0.25,
-        "class_amp": {name: float(np.clip(rng.normal(1.0, 0.08), 0.8, 1.2)) for name in MOTION_CLASSES},
+        "class_amp": {
+            name: float(np.clip(rng.normal(1.0, 0.08), 0.8, 1.2)) for name in MOTION_CLASSES
+        },
     }
 
 
@@ -276,7 +325,9 @@ def _clip_params(name, subject, rng):
     return {
         "scale": subject["scale"],
         "tempo": subject["tempo"] * float(np.clip(rng.normal(1.0, 0.08), 0.8, 1.2)),
-        "amp": subject["amp"] * subject["class_amp"][name] * float(np.clip(rng.normal(1.0, 0.10), 0.75, 1.25)),
+        "amp": subject["amp"]
+        * subject["class_amp"][name]
+        * float(np.clip(rng.normal(1.0, 0.10), 0.75, 1.25)),
         "lean": subject["lean"],
         "carry": subject["carry"],
         "side": side,
@@ -402,7 +453,9 @@ def make_motions(
             f"classes must be distinct names from {list(MOTION_CLASSES)}; got {list(names)}."
         )
     if len(duration) != 2 or not 0 < duration[0] <= duration[1]:
-        raise ValueError(f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}.")
+        raise ValueError(
+            f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}."
+        )
     rng = check_random_state(random_state)
     subjects = [_subject_style(rng) for _ in range(n_subjects)]
     reference = humanoid_skeleton()

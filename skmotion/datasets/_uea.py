@@ -79,7 +79,9 @@ def load_uea(name_or_path, *, subset="all", data_home=None):
     for part, file in files.items():
         part_clips, labels = read_ts(file)
         if labels is None:
-            raise ValueError(f"{file} has no class labels; load_uea needs a classification dataset.")
+            raise ValueError(
+                f"{file} has no class labels; load_uea needs a classification dataset."
+            )
         clips += part_clips
         target.append(labels)
         parts += [part] * len(part_clips)

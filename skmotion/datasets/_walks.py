@@ -22,7 +22,11 @@ def _sideways_gait(pose, phi, sign, amp):
     for side, shift in (("Left", 0.0), ("Right", np.pi)):
         ph = phi + shift
         lead = 1.0 if (side == "Left") == (sign > 0) else 0.6
-        pose.hip(side, 6.0 + 10.0 * amp * _bump(ph, 1.2, 0.6), abduct=2.0 + 9.0 * lead * amp * (1 + np.sin(ph)) / 2)
+        pose.hip(
+            side,
+            6.0 + 10.0 * amp * _bump(ph, 1.2, 0.6),
+            abduct=2.0 + 9.0 * lead * amp * (1 + np.sin(ph)) / 2,
+        )
         pose.knee(side, 6.0 + 30.0 * amp * _bump(ph, 1.2, 0.6))
         pose.ankle(side, 4.0 * np.sin(ph))
         pose.shoulder(side, 0.0, abduct=8.0 + 4.0 * np.sin(ph))
@@ -44,8 +48,25 @@ def _walk_clip(skeleton, direction, n_frames, frame_rate, p):
         f = 0.9 * p["tempo"] * (1.0 if direction == "forward" else -1.0)
         phi = _TWO_PI * f * t + p["phase"]
         gait = {"amp": p["amp"], "lean": 0.0, "carry": 8.0}
-        _gait(pose, phi, gait, hip=(4, 22), knee=(5, 55, -0.35), stance=12, ankle=8, arm=16, elbow=(12, 10), lean=2)
-        speed = (1.3 if direction == "forward" else 0.8) * p["scale"] * p["amp"] * p["tempo"] * (1 + 0.05 * np.cos(2 * phi))
+        _gait(
+            pose,
+            phi,
+            gait,
+            hip=(4, 22),
+            knee=(5, 55, -0.35),
+            stance=12,
+            ankle=8,
+            arm=16,
+            elbow=(12, 10),
+            lean=2,
+        )
+        speed = (
+            (1.3 if direction == "forward" else 0.8)
+            * p["scale"]
+            * p["amp"]
+            * p["tempo"]
+            * (1 + 0.05 * np.cos(2 * phi))
+        )
     yaw = p["heading"] + p["turn"] * t
     # Integrate the travel exactly on the frame grid: frame k moves by speed * dt.
     step = speed / frame_rate
@@ -60,12 +81,16 @@ def _walk_clip(skeleton, direction, n_frames, frame_rate, p):
     channels[:, col["Xposition"]] = x
     channels[:, col["Zposition"]] = z
     fk = forward_kinematics(skeleton, channels)
-    feet = [skeleton.joint_index(j) for j in ("LeftFoot", "RightFoot", "LeftToe_end", "RightToe_end")]
+    feet = [
+        skeleton.joint_index(j) for j in ("LeftFoot", "RightFoot", "LeftToe_end", "RightToe_end")
+    ]
     heights = fk.positions[:, feet, 1]
     heights[:, :2] -= 0.08 * p["scale"]
     channels[:, col["Yposition"]] = -heights.min(axis=1)
     # The true planar velocity of the hips in the facing frame (forward, left), and the yaw rate.
-    velocity = np.column_stack([speed * np.cos(angle), speed * np.sin(angle), np.full(n_frames, p["turn"])])
+    velocity = np.column_stack(
+        [speed * np.cos(angle), speed * np.sin(angle), np.full(n_frames, p["turn"])]
+    )
     return channels, velocity
 
 
@@ -80,8 +105,15 @@ def _walk_clip(skeleton, direction, n_frames, frame_rate, p):
     },
     prefer_skip_nested_validation=True,
 )
-def make_walks(n_clips_per_direction=3, *, directions=None, turn=0.0, frame_rate=30.0, duration=(3.0, 4.0),
-               random_state=None):
+def make_walks(
+    n_clips_per_direction=3,
+    *,
+    directions=None,
+    turn=0.0,
+    frame_rate=30.0,
+    duration=(3.0, 4.0),
+    random_state=None,
+):
     """Generate noise-free walks forward, backward and sideways, with their true root velocity.
 
     Each clip walks in one direction relative to the subject's facing (side
@@ -137,9 +169,13 @@ def make_walks(n_clips_per_direction=3, *, directions=None, turn=0.0, frame_rate
     names = tuple(WALK_DIRECTIONS) if directions is None else tuple(directions)
     unknown = [d for d in names if d not in WALK_DIRECTIONS]
     if unknown or not names or len(set(names)) != len(names):
-        raise ValueError(f"directions must be distinct names from {list(WALK_DIRECTIONS)}; got {list(names)}.")
+        raise ValueError(
+            f"directions must be distinct names from {list(WALK_DIRECTIONS)}; got {list(names)}."
+        )
     if len(duration) != 2 or not 0 < duration[0] <= duration[1]:
-        raise ValueError(f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}.")
+        raise ValueError(
+            f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}."
+        )
     rng = check_random_state(random_state)
     clips, target, velocity, skeletons = [], [], [], []
     for label, direction in enumerate(names):

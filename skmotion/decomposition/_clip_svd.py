@@ -109,5 +109,7 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     n_vectors = min(int(n_vectors), clips[0].shape[1])
     chunks = [clips[i : i + _CHUNK] for i in range(0, len(clips), _CHUNK)]
     with small_blas():
-        parts = parallel_map(lambda chunk: _spectra_of_chunk(chunk, n_vectors), chunks, n_jobs=n_jobs)
+        parts = parallel_map(
+            lambda chunk: _spectra_of_chunk(chunk, n_vectors), chunks, n_jobs=n_jobs
+        )
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])

@@ -25,7 +25,9 @@ from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 __all__ = ["EigenMovementPCA"]
 
 
-class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None):
+class EigenMovementPCA(
+    ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
+):
     """Eigenmovements: PCA of movement segments, each coded by a few numbers.
 
     Each clip is cut into segments (strokes from rest to rest), each segment is
@@ -247,9 +249,13 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
         self.mean_ = mean
         self.components_ = axes
         self.explained_variance_ = eigenvalues[:n_components]
-        self.total_variance_ = float(np.einsum("ij,ij->", vectors - mean, vectors - mean) / n_segments)
+        self.total_variance_ = float(
+            np.einsum("ij,ij->", vectors - mean, vectors - mean) / n_segments
+        )
         total = self.total_variance_
-        self.explained_variance_ratio_ = self.explained_variance_ / total if total > 0 else np.zeros(n_components)
+        self.explained_variance_ratio_ = (
+            self.explained_variance_ / total if total > 0 else np.zeros(n_components)
+        )
         self.projection_mse_ = float(eigenvalues[n_components:].sum())
         self.projection_rms_ = float(np.sqrt(self.projection_mse_ / n_features))
         self.n_components_ = n_components
@@ -394,7 +400,9 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
         segments = self._segment_all(clips)
         rebuilt = []
         for clip, seg, vectors in zip(clips, segments, self._vectors_all(clips, segments)):
-            projected = vectors_to_segments(self._decode(self._encode(vectors)), self.n_features_in_)
+            projected = vectors_to_segments(
+                self._decode(self._encode(vectors)), self.n_features_in_
+            )
             rebuilt.append(self._place(projected, seg, len(clip)))
         return rebuilt
 
@@ -438,5 +446,7 @@ class EigenMovementPCA(ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto
         diff = np.concatenate([c - r for c, r in zip(clips, self._reconstruct(clips))])
         covered = ~np.isnan(diff)
         if not covered.any():
-            raise ValueError(f"No segments were found in the {len(clips)} clips of X: nothing to score.")
+            raise ValueError(
+                f"No segments were found in the {len(clips)} clips of X: nothing to score."
+            )
         return -float(np.sqrt(np.mean(diff[covered] ** 2)))

@@ -60,7 +60,9 @@ def segment_vectors(clips, segments, n_samples):
     out = np.empty((len(pairs), n_channels * n_samples))
     for length, rows in _by_length(pairs[:, 1] - pairs[:, 0]):
         pieces = np.stack([clips[owner[r]][pairs[r, 0] : pairs[r, 1]] for r in rows], axis=1)
-        samples = _stretch(pieces.astype(float, copy=False), n_samples)  # (n_samples, n_rows, n_channels)
+        samples = _stretch(
+            pieces.astype(float, copy=False), n_samples
+        )  # (n_samples, n_rows, n_channels)
         out[rows] = samples.transpose(1, 2, 0).reshape(len(rows), -1)
     offsets = np.cumsum([0] + [len(s) for s in segments])
     return [out[a:b] for a, b in zip(offsets[:-1], offsets[1:])]

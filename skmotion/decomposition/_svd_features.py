@@ -198,7 +198,9 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
             return u[:, :, 0]
         singular = np.sqrt(eigenvalues)
         weights = singular[:, :n_vectors] / singular.sum(axis=1, keepdims=True)
-        return np.concatenate([weights[:, i : i + 1] * u[:, :, i] for i in range(n_vectors)], axis=1)
+        return np.concatenate(
+            [weights[:, i : i + 1] * u[:, :, i] for i in range(n_vectors)], axis=1
+        )
 
     def _fit_spectra(self, eigenvalues, vectors):
         n_vectors = _N_VECTORS[self.weighting]

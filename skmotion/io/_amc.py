@@ -25,7 +25,9 @@ def _header(path, data):
         if not word or word.startswith("#"):
             continue
         if not word.startswith(":"):
-            raise MotionFileError(path, number, f"bone data before the first frame number: {word.split()[0]!r}")
+            raise MotionFileError(
+                path, number, f"bone data before the first frame number: {word.split()[0]!r}"
+            )
         if word.upper() in (":DEGREES", ":RADIANS"):
             unit = "deg" if word.upper() == ":DEGREES" else "rad"
     return unit, found.start(), data.count(b"\n", 0, found.start()) + 1
@@ -51,12 +53,20 @@ def _joint_ids(tokens, which, skeleton):
     lengths = ends - starts
     buffer = np.frombuffer(tokens.data + bytes(16), dtype=np.uint8)
     window = np.arange(16)
-    chars = np.where(window < lengths[:, None], buffer[starts[:, None] + window], 0).astype(np.uint8)
+    chars = np.where(window < lengths[:, None], buffer[starts[:, None] + window], 0).astype(
+        np.uint8
+    )
     keys = np.ascontiguousarray(chars).view(np.uint64)
     mixed = keys[:, 0] * np.uint64(0x9E3779B97F4A7C15) ^ keys[:, 1] ^ lengths.astype(np.uint64)
     unique, first, inverse = np.unique(mixed, return_index=True, return_inverse=True)
-    exact = (keys == keys[first][inverse]).all(axis=1) & (lengths == lengths[first][inverse]) & (lengths <= 16)
-    ids = np.array([index.get(tokens.data[starts[k] : ends[k]], -1) for k in first], dtype=np.intp)[inverse]
+    exact = (
+        (keys == keys[first][inverse]).all(axis=1)
+        & (lengths == lengths[first][inverse])
+        & (lengths <= 16)
+    )
+    ids = np.array([index.get(tokens.data[starts[k] : ends[k]], -1) for k in first], dtype=np.intp)[
+        inverse
+    ]
     for k in np.flatnonzero(~exact):
         ids[k] = index.get(tokens.data[starts[k] : ends[k]], -1)
     return ids
@@ -129,14 +139,18 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
            [ 0., 20., -10.]])
     """
     if not isinstance(skeleton, Skeleton):
-        raise TypeError(f"skeleton must be a Skeleton (from read_asf), got {type(skeleton).__name__}.")
+        raise TypeError(
+            f"skeleton must be a Skeleton (from read_asf), got {type(skeleton).__name__}."
+        )
     data = read_bytes(path)
     unit, start, first_line = _header(path, data)
     tokens = Tokens(data[start:], first_line=first_line)
     buffer = np.frombuffer(tokens.data, dtype=np.uint8)
     first_byte = buffer[tokens.starts]
     lead = np.r_[True, tokens.lines[1:] != tokens.lines[:-1]]  # first token of its line
-    named = ((first_byte | 32) >= ord("a")) & ((first_byte | 32) <= ord("z")) | (first_byte == ord("_"))
+    named = ((first_byte | 32) >= ord("a")) & ((first_byte | 32) <= ord("z")) | (
+        first_byte == ord("_")
+    )
     misplaced = np.flatnonzero(named & ~lead)
     if misplaced.size:
         k = misplaced[0]
@@ -145,7 +159,9 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     joints = _joint_ids(tokens, name_tokens, skeleton)
     if (joints < 0).any():
         k = name_tokens[np.flatnonzero(joints < 0)[0]]
-        raise MotionFileError(path, int(tokens.lines[k]), f"unknown bone {tokens.text(k)!r} (not in the skeleton)")
+        raise MotionFileError(
+            path, int(tokens.lines[k]), f"unknown bone {tokens.text(k)!r} (not in the skeleton)"
+        )
 
     # Line structure: frame lines hold a lone number; bone lines a name and its values.
     lead_tokens = np.flatnonzero(lead)
@@ -164,7 +180,8 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
         k = lead_tokens[~is_frame][bad[0]]
         j = line_joint[~is_frame][bad[0]]
         raise MotionFileError(
-            path, int(tokens.lines[k]),
+            path,
+            int(tokens.lines[k]),
             f"bone {skeleton.joints[j]!r} has {per_line[~is_frame][bad[0]] - 1} values, but its dof has {counts[j]}",
         )
 
@@ -177,7 +194,8 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     if (steps != 1).any():
         k = int(np.flatnonzero(steps != 1)[0]) + 1
         raise MotionFileError(
-            path, int(frame_lines[k]),
+            path,
+            int(frame_lines[k]),
             f"frame number {frame_numbers[k]:g} follows {frame_numbers[k - 1]:g}; frames must count up by one",
         )
     n_frames = len(frame_numbers)
@@ -185,14 +203,17 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     bone_frames = frame_of_line[~is_frame]
     bone_joints = line_joint[~is_frame]
     animated = np.flatnonzero(counts > 0)
-    seen = np.bincount(bone_frames * skeleton.n_joints + bone_joints, minlength=n_frames * skeleton.n_joints)
+    seen = np.bincount(
+        bone_frames * skeleton.n_joints + bone_joints, minlength=n_frames * skeleton.n_joints
+    )
     seen = seen.reshape(n_frames, skeleton.n_joints)
     wrong = seen[:, animated] != 1
     if wrong.any():
         f, a = np.argwhere(wrong)[0]
         what = "lacks" if seen[f, animated[a]] == 0 else "lists twice"
         raise MotionFileError(
-            path, int(frame_lines[f]),
+            path,
+            int(frame_lines[f]),
             f"frame {frame_numbers[f]:g} {what} bone {skeleton.joints[animated[a]]!r}"
             + (" (truncated file?)" if what == "lacks" and f == n_frames - 1 else ""),
         )

@@ -9,8 +9,14 @@ from skmotion.kinematics import Skeleton, euler_to_matrix
 __all__ = ["acclaim_order", "read_asf"]
 
 _ROTATION_DOFS = {"rx": "X", "ry": "Y", "rz": "Z"}
-_ROOT_DOFS = {"tx": "Xposition", "ty": "Yposition", "tz": "Zposition",
-              "rx": "Xrotation", "ry": "Yrotation", "rz": "Zrotation"}
+_ROOT_DOFS = {
+    "tx": "Xposition",
+    "ty": "Yposition",
+    "tz": "Zposition",
+    "rx": "Xrotation",
+    "ry": "Yrotation",
+    "rz": "Zrotation",
+}
 _INCH = 0.0254
 
 
@@ -120,7 +126,9 @@ def _parse_root(lines):
             dofs = [w.lower() for w in words[1:]]
             unknown = [d for d in dofs if d not in _ROOT_DOFS]
             if unknown or len(set(dofs)) != len(dofs):
-                raise lines.error(line, f"root order must list distinct TX TY TZ RX RY RZ, found {words[1:]}")
+                raise lines.error(
+                    line, f"root order must list distinct TX TY TZ RX RY RZ, found {words[1:]}"
+                )
             root["order"] = dofs
         elif key == "axis":
             root["axis"] = _axis_order(lines, line, words[1] if len(words) > 1 else "")
@@ -162,7 +170,9 @@ def _parse_bone(lines, opened):
             dofs = [w.lower() for w in words[1:]]
             bad = [d for d in dofs if d not in _ROTATION_DOFS]
             if bad:
-                raise lines.error(line, f"dof {bad[0]!r} is not supported on a bone (only rx, ry, rz)")
+                raise lines.error(
+                    line, f"dof {bad[0]!r} is not supported on a bone (only rx, ry, rz)"
+                )
             if len(set(dofs)) != len(dofs):
                 raise lines.error(line, f"dof lists an axis twice: {words[1:]}")
             bone["dof"] = dofs
@@ -220,7 +230,14 @@ def _build(lines, units, root, bones, children):
         orders.append(order)
         axes.append(axis)
 
-    add("root", -1, root["position"], [_ROOT_DOFS[d] for d in root["order"]], acclaim_order(root["axis"]), np.eye(3))
+    add(
+        "root",
+        -1,
+        root["position"],
+        [_ROOT_DOFS[d] for d in root["order"]],
+        acclaim_order(root["axis"]),
+        np.eye(3),
+    )
     stack = [(child, 0) for child in reversed(children.get("root", []))]
     vectors = {}
     while stack:

@@ -80,7 +80,9 @@ class _HeaderParser:
         if self.pos < len(self.tokens):
             word, line = self.tokens[self.pos]
             if word.upper() == "ROOT":
-                raise self.error("a second ROOT: files with several hierarchies are not supported", line)
+                raise self.error(
+                    "a second ROOT: files with several hierarchies are not supported", line
+                )
             raise self.error(f"unexpected {word!r} after the hierarchy (a '}}' too many?)", line)
 
     def joint(self, parent):
@@ -115,13 +117,16 @@ class _HeaderParser:
         self.expect("CHANNELS", f"in joint {name!r}")
         word, line = self.next("the channel count")
         if not word.isdigit():
-            raise self.error(f"channel count of joint {name!r} must be an integer, found {word!r}", line)
+            raise self.error(
+                f"channel count of joint {name!r} must be an integer, found {word!r}", line
+            )
         channels = []
         for _ in range(int(word)):
             word, line = self.next(f"a channel name of joint {name!r}")
             if word.lower() not in _CHANNELS:
                 raise self.error(
-                    f"unknown channel {word!r} of joint {name!r} (expected one of {list(CHANNEL_KINDS)})", line
+                    f"unknown channel {word!r} of joint {name!r} (expected one of {list(CHANNEL_KINDS)})",
+                    line,
                 )
             channels.append(_CHANNELS[word.lower()])
         return channels
@@ -154,7 +159,11 @@ def _frame_rate(path, line, text):
     decimals = len(text.split(".")[1]) if "." in text and "e" not in text.lower() else 17
     whole = round(rate)
     # 0.008333 is 120 Hz written to 6 decimals: keep 120 rather than 120.005 (but 0.03 s stays 33.3 Hz).
-    if whole > 0 and abs(1.0 / whole - frame_time) <= 0.5 * 10.0**-decimals and abs(rate - whole) < 1e-3 * whole:
+    if (
+        whole > 0
+        and abs(1.0 / whole - frame_time) <= 0.5 * 10.0**-decimals
+        and abs(rate - whole) < 1e-3 * whole
+    ):
         return float(whole)
     return rate
 
@@ -188,7 +197,9 @@ def detect_up_axis(skeleton, channels, *, max_frames=25):
     'y'
     """
     channels = np.asarray(channels)
-    frames = np.unique(np.linspace(0, len(channels) - 1, min(len(channels), max_frames)).round().astype(int))
+    frames = np.unique(
+        np.linspace(0, len(channels) - 1, min(len(channels), max_frames)).round().astype(int)
+    )
     positions = forward_kinematics(skeleton, channels[frames]).positions
     extents = np.median(positions.max(axis=1) - positions.min(axis=1), axis=0)
     return "xyz"[int(np.argmax(extents))]
@@ -203,11 +214,15 @@ def _motion_block(path, data, start, n_channels):
         flags=re.IGNORECASE,
     )
     if header is None:
-        raise MotionFileError(path, first_line, "expected 'MOTION', 'Frames: N' and 'Frame Time: T' lines")
+        raise MotionFileError(
+            path, first_line, "expected 'MOTION', 'Frames: N' and 'Frame Time: T' lines"
+        )
     line_of = lambda offset: data.count(b"\n", 0, start + offset) + 1  # noqa: E731
     frames_text = header.group(1).decode("latin-1")
     if not frames_text.isdigit():
-        raise MotionFileError(path, line_of(header.start(1)), f"Frames must be an integer, found {frames_text!r}")
+        raise MotionFileError(
+            path, line_of(header.start(1)), f"Frames must be an integer, found {frames_text!r}"
+        )
     n_frames = int(frames_text)
     frame_rate = _frame_rate(path, line_of(header.start(2)), header.group(2).decode("latin-1"))
     body = data[start + header.end() :]
@@ -229,17 +244,22 @@ def _motion_block(path, data, start, n_channels):
     if wrong.size:
         line = int(wrong[0]) + tokens.first_line
         raise MotionFileError(
-            path, line, f"{per_line[wrong[0]]} values on a frame line, but the hierarchy has {n_channels} channels"
+            path,
+            line,
+            f"{per_line[wrong[0]]} values on a frame line, but the hierarchy has {n_channels} channels",
         )
     if len(filled) != n_frames:
         if len(filled) < n_frames:
             last = int(filled[-1]) + tokens.first_line if len(filled) else tokens.first_line - 1
             raise MotionFileError(
-                path, last, f"the MOTION block ends after {len(filled)} frames, but 'Frames: {n_frames}' "
-                "was declared (truncated file?)"
+                path,
+                last,
+                f"the MOTION block ends after {len(filled)} frames, but 'Frames: {n_frames}' "
+                "was declared (truncated file?)",
             )
         raise MotionFileError(
-            path, int(filled[n_frames]) + tokens.first_line,
+            path,
+            int(filled[n_frames]) + tokens.first_line,
             f"more frame lines than the {n_frames} declared by 'Frames:'",
         )
     values = parse_floats(tokens, path)  # names the offending line

@@ -29,7 +29,9 @@ def _joint_plan(skeleton):
         column += len(channels)
         positions = [c for c in channels if c.endswith("position")]
         axes = _rotation_axes(channels)
-        has_axis = skeleton.axes is not None and not np.allclose(skeleton.axes[j], np.eye(3), atol=1e-12)
+        has_axis = skeleton.axes is not None and not np.allclose(
+            skeleton.axes[j], np.eye(3), atol=1e-12
+        )
         if axes and has_axis:
             rotations = [f"{a}rotation" for a in order]
             mode = "matrix"
@@ -39,7 +41,8 @@ def _joint_plan(skeleton):
         plan.append(
             {
                 "written": positions + rotations,
-                "sources": [columns[c] for c in positions] + ([] if mode == "matrix" else [columns[c] for c in rotations]),
+                "sources": [columns[c] for c in positions]
+                + ([] if mode == "matrix" else [columns[c] for c in rotations]),
                 "mode": mode,
                 "angles": [columns.get(f"{a}rotation") for a in order],
             }
@@ -74,7 +77,9 @@ def _values(skeleton, channels, plan):
             order = skeleton.rotation_orders[j]
             axis = skeleton.axes[j]
             local = axis @ euler_to_matrix(angles, order) @ axis.T
-            block = np.hstack([channels[:, step["sources"]], np.rad2deg(matrix_to_euler(local, order))])
+            block = np.hstack(
+                [channels[:, step["sources"]], np.rad2deg(matrix_to_euler(local, order))]
+            )
         blocks.append(block)
     return np.hstack(blocks) if blocks else np.empty((len(channels), 0))
 

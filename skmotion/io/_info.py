@@ -12,10 +12,14 @@ __all__ = ["describe_file"]
 
 def _skeleton_lines(skeleton):
     end_sites = len(skeleton.end_sites)
-    unit = skeleton.units if skeleton.meters_per_unit is None else (
-        f"{skeleton.units} ({skeleton.meters_per_unit:.6g} m)"
+    unit = (
+        skeleton.units
+        if skeleton.meters_per_unit is None
+        else (f"{skeleton.units} ({skeleton.meters_per_unit:.6g} m)")
     )
-    orders = Counter(o for o, c in zip(skeleton.rotation_orders, skeleton.channels) if any("rot" in x for x in c))
+    orders = Counter(
+        o for o, c in zip(skeleton.rotation_orders, skeleton.channels) if any("rot" in x for x in c)
+    )
     lines = [
         f"skeleton: {skeleton.n_joints} joints ({skeleton.n_joints - end_sites} with channels or children, "
         f"{end_sites} end sites), root {skeleton.joints[0]!r}, {skeleton.up_axis}-up, length unit {unit}",
@@ -37,7 +41,9 @@ def _find_asf(amc):
     for candidate in candidates:
         if candidate.is_file():
             return candidate
-    raise FileNotFoundError(f"No skeleton for {amc}: give --asf (no {subject}.asf or other .asf beside it).")
+    raise FileNotFoundError(
+        f"No skeleton for {amc}: give --asf (no {subject}.asf or other .asf beside it)."
+    )
 
 
 def describe_file(path, *, asf=None):
@@ -75,8 +81,12 @@ def describe_file(path, *, asf=None):
     suffix = path.suffix.lower()
     if suffix == ".asf":
         skeleton = read_asf(path)
-        return [f"file: {path}", "format: Acclaim skeleton (ASF)", *_skeleton_lines(skeleton),
-                f"channels: {skeleton.n_channels} (an AMC frame of this skeleton)"]
+        return [
+            f"file: {path}",
+            "format: Acclaim skeleton (ASF)",
+            *_skeleton_lines(skeleton),
+            f"channels: {skeleton.n_channels} (an AMC frame of this skeleton)",
+        ]
     if suffix == ".amc":
         asf = Path(asf) if asf is not None else _find_asf(path)
         motion = read_amc(path, read_asf(asf))
@@ -85,7 +95,9 @@ def describe_file(path, *, asf=None):
         motion = read_bvh(path)
         kind = "BVH"
     else:
-        raise ValueError(f"{path}: unknown motion file type {suffix!r} (expected .bvh, .amc or .asf)")
+        raise ValueError(
+            f"{path}: unknown motion file type {suffix!r} (expected .bvh, .amc or .asf)"
+        )
     names = motion.channel_names
     shown = ", ".join(names[:6]) + (f", ... ({len(names) - 6} more)" if len(names) > 6 else "")
     return [

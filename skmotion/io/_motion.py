@@ -67,7 +67,9 @@ class Motion:
             )
         if not isinstance(frame_rate, Real) or isinstance(frame_rate, bool):
             # A string or None is not parsed or guessed: say what was given.
-            raise TypeError(f"frame_rate must be a number of Hz, got {type(frame_rate).__name__} {frame_rate!r}.")
+            raise TypeError(
+                f"frame_rate must be a number of Hz, got {type(frame_rate).__name__} {frame_rate!r}."
+            )
         frame_rate = float(frame_rate)
         if not frame_rate > 0 or not np.isfinite(frame_rate):
             raise ValueError(f"frame_rate must be a positive number of Hz, got {frame_rate!r}.")
@@ -150,7 +152,9 @@ def as_motions(clips, skeletons, frame_rate, *, sources=None):
         skeletons = [skeletons] * len(clips)
     skeletons = list(skeletons)
     if len(skeletons) != len(clips):
-        raise ValueError(f"{len(skeletons)} skeletons for {len(clips)} clips; give one per clip or one for all.")
+        raise ValueError(
+            f"{len(skeletons)} skeletons for {len(clips)} clips; give one per clip or one for all."
+        )
     sources = [None] * len(clips) if sources is None else list(sources)
     if len(sources) != len(clips):
         raise ValueError(f"{len(sources)} sources for {len(clips)} clips.")

@@ -115,7 +115,9 @@ def parse_floats(tokens, path, which=None, rows=None):
             np.add.reduceat(drop.astype(np.intp), rows) if drop is not None else 0
         )
         if (per_row == per_row[0]).all():
-            base = buffer if buffer is not None else np.frombuffer(tokens.data, dtype=np.uint8).copy()
+            base = (
+                buffer if buffer is not None else np.frombuffer(tokens.data, dtype=np.uint8).copy()
+            )
             values = _as_table(base, tokens, rows)
     if values is None:
         data = tokens.data if buffer is None else buffer.tobytes()

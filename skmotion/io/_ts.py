@@ -33,13 +33,17 @@ def _parse_header(path, lines):
         elif key == "classlabel":
             flag, _, labels = value.partition(" ")
             if flag.lower() not in ("true", "false"):
-                raise MotionFileError(path, number, f"@classLabel must start with true or false, got {flag!r}")
+                raise MotionFileError(
+                    path, number, f"@classLabel must start with true or false, got {flag!r}"
+                )
             tags["classlabel"] = labels.split() if flag.lower() == "true" else None
         elif key in ("dimensions", "serieslength"):
             try:
                 tags[key] = int(value)
             except ValueError:
-                raise MotionFileError(path, number, f"@{key} must be an integer, got {value!r}") from None
+                raise MotionFileError(
+                    path, number, f"@{key} must be an integer, got {value!r}"
+                ) from None
         else:
             tags[key] = value
     raise MotionFileError(path, None, "no @data tag: not a .ts file")
@@ -51,13 +55,17 @@ def _parse_dimension(path, number, index, text):
         column = np.array(values, dtype=float)
     except ValueError:
         bad = next(v for v in values if not _is_float(v))
-        raise MotionFileError(path, number, f"dimension {index + 1}: non-numeric value {bad.strip()!r}") from None
+        raise MotionFileError(
+            path, number, f"dimension {index + 1}: non-numeric value {bad.strip()!r}"
+        ) from None
     infinite = np.flatnonzero(np.isinf(column))
     if infinite.size:
         # NaN is a missing value (written '?'); an infinity is a broken value.
         raise MotionFileError(
-            path, number, f"dimension {index + 1}: non-finite value {values[infinite[0]].strip()!r} "
-            f"at position {infinite[0] + 1} (write missing values as '?')"
+            path,
+            number,
+            f"dimension {index + 1}: non-finite value {values[infinite[0]].strip()!r} "
+            f"at position {infinite[0] + 1} (write missing values as '?')",
         )
     return column
 
@@ -131,21 +139,31 @@ def read_ts(path):
         if class_labels is not None:
             label = fields.pop().strip()
             if label not in class_labels:
-                raise MotionFileError(path, number, f"class label {label!r} is not declared in @classLabel {class_labels}")
+                raise MotionFileError(
+                    path,
+                    number,
+                    f"class label {label!r} is not declared in @classLabel {class_labels}",
+                )
             labels.append(label)
         if n_dims is None:
             n_dims = len(fields)
         if len(fields) != n_dims:
-            raise MotionFileError(path, number, f"{len(fields)} dimensions, but the file declares {n_dims}")
+            raise MotionFileError(
+                path, number, f"{len(fields)} dimensions, but the file declares {n_dims}"
+            )
         columns = [_parse_dimension(path, number, k, text) for k, text in enumerate(fields)]
         lengths = {len(c) for c in columns}
         if len(lengths) != 1:
             raise MotionFileError(
-                path, number, f"dimensions of one series differ in length: {[len(c) for c in columns]}"
+                path,
+                number,
+                f"dimensions of one series differ in length: {[len(c) for c in columns]}",
             )
         if tags.get("equallength") and tags.get("serieslength") not in (None, len(columns[0])):
             raise MotionFileError(
-                path, number, f"series of length {len(columns[0])}, but @seriesLength is {tags['serieslength']}"
+                path,
+                number,
+                f"series of length {len(columns[0])}, but @seriesLength is {tags['serieslength']}",
             )
         clips.append(np.stack(columns, axis=1))
     if not clips:

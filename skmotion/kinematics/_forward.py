@@ -133,7 +133,9 @@ def forward_kinematics(skeleton, channels):
     for idx in plan["levels"]:
         parent_rot = rotations[parents[idx]]
         rotations[idx] = parent_rot @ local[idx]
-        positions[idx] = positions[parents[idx]] + (parent_rot @ translations[idx][..., None])[..., 0]
+        positions[idx] = (
+            positions[parents[idx]] + (parent_rot @ translations[idx][..., None])[..., 0]
+        )
     positions = np.ascontiguousarray(positions.transpose(1, 0, 2))
     rotations = np.ascontiguousarray(rotations.transpose(1, 0, 2, 3))
     return FKResult(positions, rotations)

@@ -35,9 +35,7 @@ def check_rotation_order(order, *, where="rotation order"):
     'ZXY'
     """
     if not isinstance(order, str) or sorted(order.upper()) != list(AXES):
-        raise ValueError(
-            f"{where} must be a permutation of 'XYZ' (e.g. 'ZXY'), got {order!r}."
-        )
+        raise ValueError(f"{where} must be a permutation of 'XYZ' (e.g. 'ZXY'), got {order!r}.")
     return order.upper()
 
 

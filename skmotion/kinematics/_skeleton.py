@@ -176,7 +176,11 @@ class Skeleton:
         set_(self, "axes", axes)
         set_(self, "up_axis", up_axis)
         set_(self, "units", str(self.units))
-        set_(self, "meters_per_unit", None if self.meters_per_unit is None else float(self.meters_per_unit))
+        set_(
+            self,
+            "meters_per_unit",
+            None if self.meters_per_unit is None else float(self.meters_per_unit),
+        )
 
     # -- identity -------------------------------------------------------------
     @cached_property
@@ -273,7 +277,9 @@ class Skeleton:
         try:
             return self.joints.index(joint)
         except ValueError:
-            raise KeyError(f"Unknown joint {joint!r}; this skeleton has {list(self.joints)}.") from None
+            raise KeyError(
+                f"Unknown joint {joint!r}; this skeleton has {list(self.joints)}."
+            ) from None
 
     def channel_index(self, joint, channel):
         """Column of ``channel`` (e.g. ``"Xrotation"``) of ``joint`` in a clip."""

@@ -106,14 +106,19 @@ class IntervalIndex:
         self.edges = [np.asarray(e, dtype=np.float64) for e in edges]
         self.radius = np.asarray(radius, dtype=np.float64)
         if self.radius.shape != (len(self.edges),) or (self.radius < 0).any():
-            raise ValueError(f"radius must hold one non-negative value per level ({len(self.edges)}).")
+            raise ValueError(
+                f"radius must hold one non-negative value per level ({len(self.edges)})."
+            )
         for level, e in enumerate(self.edges):
             if e.ndim != 1 or (np.diff(e) <= 0).any():
                 raise ValueError(f"edges of level {level} must be a strictly increasing 1-D array.")
         self.n_entries = [len(e) + 1 for e in self.edges]
         self._edge_lists = [e.tolist() for e in self.edges]  # for bisect (one query)
         # Level 0 holds the dead node 0 and the root 1.
-        self._tables = [np.zeros((2 if level == 0 else 1, n), dtype=np.int32) for level, n in enumerate(self.n_entries)]
+        self._tables = [
+            np.zeros((2 if level == 0 else 1, n), dtype=np.int32)
+            for level, n in enumerate(self.n_entries)
+        ]
         self._n_nodes = [2] + [1] * (self.n_levels - 1)
         self._n_leaves = 1
         self._blocks = []  # (leaf ids, offsets, items), oldest (lowest item ids) first
@@ -210,7 +215,11 @@ class IntervalIndex:
         order = np.argsort(leaf, kind="stable")
         leaf, items = leaf[order], items[order]
         starts = np.flatnonzero(np.r_[True, leaf[1:] != leaf[:-1]])
-        return leaf[starts].astype(np.int32), np.r_[starts, len(leaf)].astype(np.int64), items.astype(np.int32)
+        return (
+            leaf[starts].astype(np.int32),
+            np.r_[starts, len(leaf)].astype(np.int64),
+            items.astype(np.int32),
+        )
 
     def _add_block(self, leaf, items):
         self._blocks.append(self._block(leaf, items))

@@ -59,7 +59,9 @@ def learn_delta(features, labels, quantile):
     order = np.argsort(codes.ravel(), kind="stable")
     starts = np.r_[0, np.cumsum(counts)[:-1]]
     ordered = features[order]
-    spreads = (np.maximum.reduceat(ordered, starts, axis=0) - np.minimum.reduceat(ordered, starts, axis=0))[counts > 1]
+    spreads = (
+        np.maximum.reduceat(ordered, starts, axis=0) - np.minimum.reduceat(ordered, starts, axis=0)
+    )[counts > 1]
     if not len(spreads):
         return np.zeros(features.shape[1])
     return np.quantile(spreads, quantile, axis=0)
@@ -72,7 +74,10 @@ def _extend(buffer, n, new):
     """
     need = n + len(new)
     if buffer is None or need > len(buffer):
-        grown = np.empty((max(need, 2 * (0 if buffer is None else len(buffer))),) + new.shape[1:], dtype=new.dtype)
+        grown = np.empty(
+            (max(need, 2 * (0 if buffer is None else len(buffer))),) + new.shape[1:],
+            dtype=new.dtype,
+        )
         if buffer is not None:
             grown[:n] = buffer[:n]
         buffer = grown
@@ -227,7 +232,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             self.input_kind_ = "table" if _is_table(X) else "clips"
         elif ("table" if _is_table(X) else "clips") != self.input_kind_:
             expected = "a 2-D array of feature vectors" if self.input_kind_ == "table" else "clips"
-            raise ValueError(f"X: {type(self).__name__} was fitted on {expected}; pass the same kind.")
+            raise ValueError(
+                f"X: {type(self).__name__} was fitted on {expected}; pass the same kind."
+            )
         if self.input_kind_ == "table":
             table = validate_data(self, X, reset=reset, dtype=np.float64)
             return table, table
@@ -294,7 +301,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
         radius = self.epsilon * self.delta_
         low, high = tree_features.min(axis=0), tree_features.max(axis=0)
-        edges = [entry_edges(low[i], high[i], radius[i], self.max_entries) for i in range(self.n_levels)]
+        edges = [
+            entry_edges(low[i], high[i], radius[i], self.max_entries) for i in range(self.n_levels)
+        ]
         self.index_ = IntervalIndex(edges, radius)
         self.index_.insert(tree_features)
         self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
@@ -306,7 +315,12 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     def _store(self, tree_features, ranking, encoded):
         """Append clips' tree features, ranking data and labels to the stored ones."""
         labels = self.classes_[encoded]
-        new = (tree_features, encoded, labels, *(ranking if isinstance(ranking, tuple) else (ranking,)))
+        new = (
+            tree_features,
+            encoded,
+            labels,
+            *(ranking if isinstance(ranking, tuple) else (ranking,)),
+        )
         old = self._buffers or (None,) * len(new)
         n = self.n_samples_fit_
         self._buffers = tuple(_extend(b, n, a) for b, a in zip(old, new))
@@ -424,7 +438,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             return euclidean_distances(ranking[rows], self._ranking[columns])
         weights, vectors = ranking
         stored_weights, stored_vectors = self._ranking
-        return 1.0 - psi_from_signatures(weights[rows], vectors[rows], stored_weights[columns], stored_vectors[columns])
+        return 1.0 - psi_from_signatures(
+            weights[rows], vectors[rows], stored_weights[columns], stored_vectors[columns]
+        )
 
     def _rank_leaf(self, leaf, rows, ranking, self_ids, n_neighbors):
         columns = self.index_.leaf_items(leaf).astype(np.intp)
@@ -439,7 +455,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             part.sort(axis=1)  # equal distances: the lower id first
         else:
             part = np.broadcast_to(np.arange(columns.size), distances.shape)
-        order = np.argsort(np.take_along_axis(distances, part, axis=1), axis=1, kind="stable")[:, :n_neighbors]
+        order = np.argsort(np.take_along_axis(distances, part, axis=1), axis=1, kind="stable")[
+            :, :n_neighbors
+        ]
         chosen = np.take_along_axis(part, order, axis=1)
         return rows, np.take_along_axis(distances, chosen, axis=1), columns[chosen]
 
@@ -478,7 +496,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         tasks = [groups[i : i + _LEAVES_PER_TASK] for i in range(0, len(groups), _LEAVES_PER_TASK)]
 
         def rank(task):
-            return [self._rank_leaf(leaf, rows, ranking, self_ids, n_neighbors) for leaf, rows in task]
+            return [
+                self._rank_leaf(leaf, rows, ranking, self_ids, n_neighbors) for leaf, rows in task
+            ]
 
         distances = np.empty((len(features), n_neighbors))
         indices = np.empty((len(features), n_neighbors), dtype=np.intp)

@@ -9,7 +9,13 @@ from skmotion.utils._clips import check_clips
 from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, validate_params
 
-__all__ = ["pairwise_psi", "psi", "psi_from_signatures", "psi_signatures", "signatures_from_spectra"]
+__all__ = [
+    "pairwise_psi",
+    "psi",
+    "psi_from_signatures",
+    "psi_signatures",
+    "signatures_from_spectra",
+]
 
 # Rows of the similarity matrix per task: bounds memory, independent of n_jobs.
 _ROWS = 1024
@@ -123,7 +129,9 @@ def psi(Q, P, k=6):
     """
     clips = check_clips([Q, P], input_name="[Q, P]")
     signatures = psi_signatures(clips, k)
-    return float(psi_from_signatures(*(s[:1] for s in signatures), *(s[1:] for s in signatures))[0, 0])
+    return float(
+        psi_from_signatures(*(s[:1] for s in signatures), *(s[1:] for s in signatures))[0, 0]
+    )
 
 
 @validate_params(
@@ -185,5 +193,9 @@ def pairwise_psi(X, Y=None, k=6, *, n_jobs=None):
             )
         b = psi_signatures(clips_y, k, n_jobs=n_jobs)
     starts = range(0, len(a[0]), _ROWS)
-    rows = parallel_map(lambda s: psi_from_signatures(a[0][s : s + _ROWS], a[1][s : s + _ROWS], *b), starts, n_jobs=n_jobs)
+    rows = parallel_map(
+        lambda s: psi_from_signatures(a[0][s : s + _ROWS], a[1][s : s + _ROWS], *b),
+        starts,
+        n_jobs=n_jobs,
+    )
     return np.concatenate(rows, axis=0)

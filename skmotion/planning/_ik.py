@@ -88,7 +88,9 @@ def marker_jacobian(skeleton, markers, channels, columns, *, eps=1e-6):
     n, k = len(channels), len(columns)
     batch = np.repeat(channels[:, None, :], k + 1, axis=1)
     batch[:, 1 + np.arange(k), columns] += eps
-    pos = markers.positions(skeleton, batch.reshape(-1, channels.shape[1])).reshape(n, k + 1, len(markers), 3)
+    pos = markers.positions(skeleton, batch.reshape(-1, channels.shape[1])).reshape(
+        n, k + 1, len(markers), 3
+    )
     jac = (pos[:, 1:] - pos[:, :1]) / eps
     return pos[:, 0], np.moveaxis(jac, 1, -1)
 
@@ -139,7 +141,9 @@ def damped_ik(skeleton, markers, targets, initial, *, damping=1e-2, n_iter=30, t
         pos, jac = marker_jacobian(skeleton, markers, q, columns)
         jac = jac.reshape(len(q), -1, len(columns))
         err = (targets - pos).reshape(len(q), -1)
-        step = damped_solve(np.einsum("nji,njk->nik", jac, jac), np.einsum("nji,nj->ni", jac, err), damping)
+        step = damped_solve(
+            np.einsum("nji,njk->nik", jac, jac), np.einsum("nji,nj->ni", jac, err), damping
+        )
         q += step
         if np.abs(step).max() < tol:
             break

@@ -49,16 +49,24 @@ class SkeletonModel:
         """The model of a fitted :class:`VirtualMarkerTransform` with a skeleton."""
         skeleton = transformer.skeleton
         markers = transformer.marker_set(skeleton)
-        root, (left, right), chain = transformer.root_index_, transformer.facing_indices_, transformer.size_indices_
+        root, (left, right), chain = (
+            transformer.root_index_,
+            transformer.facing_indices_,
+            transformer.size_indices_,
+        )
         size = 1.0
         if chain is not None:
-            size = chain_size(markers.positions(skeleton, np.zeros((1, skeleton.n_channels))), chain)
+            size = chain_size(
+                markers.positions(skeleton, np.zeros((1, skeleton.n_channels))), chain
+            )
         return cls(skeleton, markers, root, left, right, size)
 
     def solve(self, body_positions):
         """Channels whose markers fit body-frame positions ``(n, n_markers, 3)``, and the RMS error (data units)."""
         targets = body_positions * self.units_per_size @ plan_axes(self.skeleton.up_axis).T
-        q0 = facing_pose(self.skeleton, self.markers, targets, root=self.root, left=self.left, right=self.right)
+        q0 = facing_pose(
+            self.skeleton, self.markers, targets, root=self.root, left=self.left, right=self.right
+        )
         q, rms = damped_ik(self.skeleton, self.markers, targets, q0)
         return q, rms / self.units_per_size
 
@@ -88,7 +96,11 @@ def node_root_velocity(means, *, model=None, damping=1e-3):
         return rigid_root_velocity(states[..., :3], states[..., 3:], damping=damping), None, None
     channels, rms = model.solve(states[..., :3])
     velocity = skeleton_root_velocity(
-        model.skeleton, model.markers, channels, states[..., 3:] * model.units_per_size, damping=damping
+        model.skeleton,
+        model.markers,
+        channels,
+        states[..., 3:] * model.units_per_size,
+        damping=damping,
     )
     return velocity / np.array([model.units_per_size, model.units_per_size, 1.0]), channels, rms
 
@@ -161,7 +173,9 @@ class MotionPlan:
     def to_motion(self):
         """The planned motion as a :class:`~skmotion.io.Motion`, to write with ``write_bvh``."""
         if self.channels is None:
-            raise ValueError("this plan has no joint angles: plan with a transformer that has a skeleton.")
+            raise ValueError(
+                "this plan has no joint angles: plan with a transformer that has a skeleton."
+            )
         return Motion(self.skeleton, self.channels, frame_rate=self.frame_rate)
 
 
@@ -192,9 +206,26 @@ def _place(model, channels, root, metres_per_unit):
     return out
 
 
-def plan_motion(means, transitions, visits, start, goal, *, frame_rate, body_size, max_frames, tolerance,
-                start_node=None, model=None, heuristic_weight=8.0, cell=0.05, heading_bins=36,
-                max_expansions=500_000, damping=1e-3, layer=-1):
+def plan_motion(
+    means,
+    transitions,
+    visits,
+    start,
+    goal,
+    *,
+    frame_rate,
+    body_size,
+    max_frames,
+    tolerance,
+    start_node=None,
+    model=None,
+    heuristic_weight=8.0,
+    cell=0.05,
+    heading_bins=36,
+    max_expansions=500_000,
+    damping=1e-3,
+    layer=-1,
+):
     """Plan a motion on one layer of a motion database; see :meth:`MotionTreeHMM.plan`.
 
     Parameters
@@ -236,16 +267,35 @@ def plan_motion(means, transitions, visits, start, goal, *, frame_rate, body_siz
         start_costs[start_node] = 0.0
     began = time.perf_counter()
     result = astar_search(
-        indptr, indices, costs, steps, start_costs, start, goal, tolerance=tolerance, max_frames=max_frames,
-        heuristic_weight=heuristic_weight, cell=cell, heading_bins=heading_bins, max_expansions=max_expansions,
+        indptr,
+        indices,
+        costs,
+        steps,
+        start_costs,
+        start,
+        goal,
+        tolerance=tolerance,
+        max_frames=max_frames,
+        heuristic_weight=heuristic_weight,
+        cell=cell,
+        heading_bins=heading_bins,
+        max_expansions=max_expansions,
     )
     search_seconds = time.perf_counter() - began
     nodes = result.nodes
     path_counts = np.asarray(counts[nodes[:-1], nodes[1:]]).ravel()
     plan = MotionPlan(
-        nodes=nodes, log_probability=-result.cost, frames=means[nodes], root=result.poses,
-        goal=np.asarray(goal, dtype=float), layer=layer, frame_rate=float(frame_rate), body_size=float(body_size),
-        seen_counts=path_counts, expansions=result.expansions, search_seconds=search_seconds,
+        nodes=nodes,
+        log_probability=-result.cost,
+        frames=means[nodes],
+        root=result.poses,
+        goal=np.asarray(goal, dtype=float),
+        layer=layer,
+        frame_rate=float(frame_rate),
+        body_size=float(body_size),
+        seen_counts=path_counts,
+        expansions=result.expansions,
+        search_seconds=search_seconds,
     )
     if model is not None:
         metres_per_unit = body_size / model.units_per_size
@@ -257,6 +307,10 @@ def plan_motion(means, transitions, visits, start, goal, *, frame_rate, body_siz
 
 def default_body_size(model):
     """Metres per data unit from a skeleton of known units, else None."""
-    if model is None or model.skeleton.meters_per_unit is None or not math.isfinite(model.skeleton.meters_per_unit):
+    if (
+        model is None
+        or model.skeleton.meters_per_unit is None
+        or not math.isfinite(model.skeleton.meters_per_unit)
+    ):
         return None
     return model.units_per_size * model.skeleton.meters_per_unit

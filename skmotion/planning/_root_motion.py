@@ -59,7 +59,9 @@ def rigid_root_velocity(positions, velocities, *, damping=1e-3):
     sx, sy, r2 = px.sum(axis=1), py.sum(axis=1), (px**2 + py**2).sum(axis=1)
     zero = np.zeros_like(m)
     # J^T J and J^T v of the rows [1, 0, -p_y] and [0, 1, p_x], summed over the markers.
-    jtj = np.stack([np.stack([m, zero, -sy], -1), np.stack([zero, m, sx], -1), np.stack([-sy, sx, r2], -1)], -2)
+    jtj = np.stack(
+        [np.stack([m, zero, -sy], -1), np.stack([zero, m, sx], -1), np.stack([-sy, sx, r2], -1)], -2
+    )
     jtv = np.stack([vx.sum(axis=1), vy.sum(axis=1), (px * vy - py * vx).sum(axis=1)], axis=-1)
     return damped_solve(jtj, jtv, damping)
 
@@ -106,7 +108,7 @@ def skeleton_root_velocity(skeleton, markers, channels, velocities, *, damping=1
     joint_cols = np.arange(len(skeleton.channels[0]), skeleton.n_channels)
     positions, jac = marker_jacobian(skeleton, markers, channels, joint_cols)
     axes = plan_axes(skeleton.up_axis)
-    p = positions @ axes                                          # (n, M, 3) in the body frame
+    p = positions @ axes  # (n, M, 3) in the body frame
     jac = np.einsum("ji,nmjk->nmik", axes, jac)
     root = p[:, markers.names.index("pelvis") if "pelvis" in markers.names else 0]
     rel = p - root[:, None, :]

@@ -72,15 +72,17 @@ def _graph_lists(indptr, indices, costs, steps, max_dwell, dwell_span):
     """
     loops, moves, dwell = [], [], []
     for m in range(len(indptr) - 1):
-        succ = indices[indptr[m]:indptr[m + 1]]
-        cost = costs[indptr[m]:indptr[m + 1]]
+        succ = indices[indptr[m] : indptr[m + 1]]
+        cost = costs[indptr[m] : indptr[m + 1]]
         own = succ == m
         loops.append(float(cost[own][0]) if own.any() else None)
         moves.append([(int(n), float(c)) for n, c in zip(succ[~own], cost[~own])])
         longest = 1
         if own.any():
             leave = -math.expm1(-float(cost[own][0]))  # 1 - p(m -> m)
-            longest = max_dwell if leave <= 0 else int(min(max_dwell, math.ceil(dwell_span / leave)))
+            longest = (
+                max_dwell if leave <= 0 else int(min(max_dwell, math.ceil(dwell_span / leave)))
+            )
         k = np.arange(1, longest + 1)
         dx, dy, dh = steps[m]
         dwell.append(_compose(dx, dy, dh, k))
@@ -95,11 +97,28 @@ def _compose(dx, dy, dh, k):
     cx = (dx - dy * math.sin(dh) / (1 - math.cos(dh))) / 2 if abs(1 - math.cos(dh)) > 1e-15 else 0.0
     cy = (dy + dx * math.sin(dh) / (1 - math.cos(dh))) / 2 if abs(1 - math.cos(dh)) > 1e-15 else 0.0
     a = k * dh
-    return np.column_stack([cx - (np.cos(a) * cx - np.sin(a) * cy), cy - (np.sin(a) * cx + np.cos(a) * cy), a])
+    return np.column_stack(
+        [cx - (np.cos(a) * cx - np.sin(a) * cy), cy - (np.sin(a) * cx + np.cos(a) * cy), a]
+    )
 
 
-def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tolerance, max_frames,
-                 heuristic_weight=1.0, cell=0.05, heading_bins=36, max_expansions=500_000, dwell_span=3.0):
+def astar_search(
+    indptr,
+    indices,
+    costs,
+    steps,
+    start_costs,
+    start,
+    goal,
+    *,
+    tolerance,
+    max_frames,
+    heuristic_weight=1.0,
+    cell=0.05,
+    heading_bins=36,
+    max_expansions=500_000,
+    dwell_span=3.0,
+):
     """Search the most probable node path whose root reaches ``goal``; see the module notes.
 
     Parameters
@@ -176,12 +195,18 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
     if frames_needed(d0) >= max_frames:
         raise UnreachableGoalError(
             f"the goal is {d0:.3f} m away, but the fastest motion of the database covers at most "
-            f"{s_max * (max_frames - 1):.3f} m in max_frames={max_frames} frames.", closest=d0,
+            f"{s_max * (max_frames - 1):.3f} m in max_frames={max_frames} frames.",
+            closest=d0,
         )
     two_pi = 2.0 * math.pi
 
     def key_of(n, x, y, h):
-        return (n, int(np.rint(x / cell)), int(np.rint(y / cell)), int((h % two_pi) / two_pi * heading_bins))
+        return (
+            n,
+            int(np.rint(x / cell)),
+            int(np.rint(y / cell)),
+            int((h % two_pi) / two_pi * heading_bins),
+        )
 
     # A search node enters graph node n at frame t with pose (x, y, h) and cost g; expanding it
     # chooses how many frames to dwell in n (self-loops) and the next node. A terminal entry
@@ -190,11 +215,23 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
     heap, best = [], {}
 
     def push(n, pose, parent, t, g, f, k=0):
-        nodes.append(n); poses.append(pose); parents.append(parent); frames.append(t); gs.append(g); dwells.append(k)
+        nodes.append(n)
+        poses.append(pose)
+        parents.append(parent)
+        frames.append(t)
+        gs.append(g)
+        dwells.append(k)
         heapq.heappush(heap, (f, len(nodes) - 1))
 
     for n in np.flatnonzero(np.isfinite(start_costs)):
-        push(int(n), tuple(map(float, start)), -1, 0, float(start_costs[n]), float(start_costs[n]) + heuristic(d0))
+        push(
+            int(n),
+            tuple(map(float, start)),
+            -1,
+            0,
+            float(start_costs[n]),
+            float(start_costs[n]) + heuristic(d0),
+        )
     closest, expansions, found, fallback = d0, 0, -1, -1
     while heap:
         _, i = heapq.heappop(heap)
@@ -223,16 +260,32 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
         dist = np.hypot(gx - px, gy - py)
         closest = min(closest, float(dist.min()))
         loop = loops[n] if loops[n] is not None else math.inf
-        at_goal = np.flatnonzero(dist[: len(table)] <= tol) if loops[n] is not None else np.flatnonzero(dist[:1] <= tol)
+        at_goal = (
+            np.flatnonzero(dist[: len(table)] <= tol)
+            if loops[n] is not None
+            else np.flatnonzero(dist[:1] <= tol)
+        )
         if len(at_goal):
             j = int(at_goal[0])  # end at frame t + j, after j self-loops
-            push(-1, (float(px[j]), float(py[j]), float(ph[j])), i, t + j, g + j * loop, g + j * loop, j + 1)
+            push(
+                -1,
+                (float(px[j]), float(py[j]), float(ph[j])),
+                i,
+                t + j,
+                g + j * loop,
+                g + j * loop,
+                j + 1,
+            )
             if fallback < 0 or gs[-1] < gs[fallback]:
                 fallback = len(nodes) - 1
         # All dwells at once: the frame after, the lower bound still to go, the cell keys.
         ks = np.arange(1, len(table) + 1)
         dk = dist[1:]
-        need = np.where(dk <= tol, 0, np.ceil((dk - tol) / s_max - 1e-12)) if s_max > 0 else np.where(dk <= tol, 0, np.inf)
+        need = (
+            np.where(dk <= tol, 0, np.ceil((dk - tol) / s_max - 1e-12))
+            if s_max > 0
+            else np.where(dk <= tol, 0, np.inf)
+        )
         ok = np.flatnonzero(t + ks + need < max_frames)
         if not len(ok) or not moves[n]:
             continue
@@ -257,10 +310,15 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
                     pose = (float(px[j + 1]), float(py[j + 1]), float(ph[j + 1]))
                 push(m, pose, i, t + j + 1, ng, ng + hk[j], j + 1)
     if found < 0:
-        why = f"gave up after max_expansions={max_expansions} expansions" if heap else "every path was explored"
+        why = (
+            f"gave up after max_expansions={max_expansions} expansions"
+            if heap
+            else "every path was explored"
+        )
         raise UnreachableGoalError(
             f"no path of the transition graph takes the root within {tol:g} m of the goal in max_frames={max_frames} "
-            f"frames ({why}); the closest approach was {closest:.3f} m.", closest=closest,
+            f"frames ({why}); the closest approach was {closest:.3f} m.",
+            closest=closest,
         )
     # Unroll: each entry dwelt dwells[child] frames in its node before the child's node.
     chain = []
@@ -275,8 +333,15 @@ def astar_search(indptr, indices, costs, steps, start_costs, start, goal, *, tol
         table = np.vstack([[0.0, 0.0, 0.0], dwell[nodes[a]][: k - 1]])
         c, s = math.cos(h), math.sin(h)
         out_nodes += [nodes[a]] * k
-        out_poses.append(np.column_stack([x + c * table[:, 0] - s * table[:, 1], y + s * table[:, 0] + c * table[:, 1],
-                                          h + table[:, 2]]))
+        out_poses.append(
+            np.column_stack(
+                [
+                    x + c * table[:, 0] - s * table[:, 1],
+                    y + s * table[:, 0] + c * table[:, 1],
+                    h + table[:, 2],
+                ]
+            )
+        )
     return SearchResult(
         nodes=np.array(out_nodes, dtype=np.intp),
         poses=np.vstack(out_poses),

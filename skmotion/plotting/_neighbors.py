@@ -43,14 +43,32 @@ def plot_pruning_recall(rows, *, n_levels=7):
     for ax, name in zip(axes[0], datasets):
         for features, style in (("first", "-"), ("first_two", "--")):
             mine = sorted(
-                (r for r in rows if r["dataset"] == name and r["features"] == features and r["n_levels"] == n_levels),
+                (
+                    r
+                    for r in rows
+                    if r["dataset"] == name
+                    and r["features"] == features
+                    and r["n_levels"] == n_levels
+                ),
                 key=lambda r: r["epsilon"],
             )
             if not mine:
                 continue
             eps = [r["epsilon"] for r in mine]
-            ax.plot(eps, [r["pruning"] for r in mine], "o" + style, color="C0", label=f"pruning ({features})")
-            ax.plot(eps, [r["recall"] for r in mine], "s" + style, color="C1", label=f"recall ({features})")
+            ax.plot(
+                eps,
+                [r["pruning"] for r in mine],
+                "o" + style,
+                color="C0",
+                label=f"pruning ({features})",
+            )
+            ax.plot(
+                eps,
+                [r["recall"] for r in mine],
+                "s" + style,
+                color="C1",
+                label=f"recall ({features})",
+            )
         ax.set_title(f"{name}, {n_levels} levels")
         ax.set_xlabel("entry interval factor epsilon")
         ax.set_ylim(0, 1.02)

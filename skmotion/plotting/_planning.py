@@ -46,8 +46,16 @@ def plot_plan(plan, *, ax=None, arrows=10):
     ax.plot([-y[0]], [x[0]], "o", color="tab:green", label="start")
     ax.plot([-plan.goal[1]], [plan.goal[0]], "*", color="tab:red", markersize=14, label="goal")
     every = np.linspace(0, len(x) - 1, max(arrows, 2)).astype(int)
-    ax.quiver(-y[every], x[every], -np.sin(heading[every]), np.cos(heading[every]), angles="xy", scale=12,
-              width=0.004, color="tab:gray")
+    ax.quiver(
+        -y[every],
+        x[every],
+        -np.sin(heading[every]),
+        np.cos(heading[every]),
+        angles="xy",
+        scale=12,
+        width=0.004,
+        color="tab:gray",
+    )
     ax.set_xlabel("left  <-  y (m)")
     ax.set_ylabel("x, ahead (m)")
     ax.set_aspect("equal")

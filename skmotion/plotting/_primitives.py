@@ -8,7 +8,9 @@ from ._pyplot import _pyplot
 __all__ = ["plot_eigenmovements"]
 
 
-def plot_eigenmovements(estimator, n_components=4, *, channels=None, channel_names=None, figsize=None):
+def plot_eigenmovements(
+    estimator, n_components=4, *, channels=None, channel_names=None, figsize=None
+):
     """The first eigenmovements, one row each, one panel per channel.
 
     Each panel shows how one channel moves over the normalised time of a
@@ -53,17 +55,26 @@ def plot_eigenmovements(estimator, n_components=4, *, channels=None, channel_nam
     n_channels = estimator.n_features_in_
     channels = list(range(n_channels)) if channels is None else [int(c) for c in channels]
     if not 1 <= n_components <= estimator.n_components_:
-        raise ValueError(f"n_components must be in [1, {estimator.n_components_}]; got {n_components}.")
+        raise ValueError(
+            f"n_components must be in [1, {estimator.n_components_}]; got {n_components}."
+        )
     if channel_names is None:
         names = getattr(estimator, "feature_names_in_", None)
         channel_names = [names[c] if names is not None else f"channel {c}" for c in channels]
     if len(channel_names) != len(channels):
-        raise ValueError(f"channel_names has {len(channel_names)} names for {len(channels)} channels.")
+        raise ValueError(
+            f"channel_names has {len(channel_names)} names for {len(channels)} channels."
+        )
     movements = estimator.components_[:n_components].reshape(n_components, n_channels, -1)
     time = np.linspace(0.0, 1.0, movements.shape[2])
     rows, cols = n_components, len(channels)
     figure, axes = plt.subplots(
-        rows, cols, sharex=True, sharey="row", squeeze=False, figsize=figsize or (2.2 * cols, 1.6 * rows)
+        rows,
+        cols,
+        sharex=True,
+        sharey="row",
+        squeeze=False,
+        figsize=figsize or (2.2 * cols, 1.6 * rows),
     )
     for i in range(rows):
         for k, c in enumerate(channels):

@@ -26,7 +26,9 @@ def _edges(graphs, layer, graph, min_probability):
     return counts.row[keep], counts.col[keep], prob[keep]
 
 
-def plot_motion_tree_layer(tree, graphs=None, layer=-1, *, graph=0, axes=(0, 1), min_probability=0.05, ax=None):
+def plot_motion_tree_layer(
+    tree, graphs=None, layer=-1, *, graph=0, axes=(0, 1), min_probability=0.05, ax=None
+):
     """The nodes of one layer on the first principal axes, with a transition graph (the paper's Figures 3-5).
 
     Each node is drawn at its mean frame projected on principal axes of all
@@ -78,17 +80,34 @@ def plot_motion_tree_layer(tree, graphs=None, layer=-1, *, graph=0, axes=(0, 1),
     if graphs is not None:
         src, dst, prob = _edges(graphs, layer, graph, min_probability)
         for a, b, p in zip(src, dst, prob):
-            ax.plot(xy[[a, b], 0], xy[[a, b], 1], color="tab:red", alpha=float(min(1.0, 0.15 + p)), lw=0.8, zorder=1)
+            ax.plot(
+                xy[[a, b], 0],
+                xy[[a, b], 1],
+                color="tab:red",
+                alpha=float(min(1.0, 0.15 + p)),
+                lw=0.8,
+                zorder=1,
+            )
     counts = tree.counts(layer)
-    ax.scatter(xy[:, 0], xy[:, 1], s=20 + 200 * counts / counts.max(), c=_node_spread(tree, layer),
-               cmap="Blues", edgecolors="k", linewidths=0.4, zorder=2)
+    ax.scatter(
+        xy[:, 0],
+        xy[:, 1],
+        s=20 + 200 * counts / counts.max(),
+        c=_node_spread(tree, layer),
+        cmap="Blues",
+        edgecolors="k",
+        linewidths=0.4,
+        zorder=2,
+    )
     ax.set_xlabel(f"principal axis {axes[0] + 1}")
     ax.set_ylabel(f"principal axis {axes[1] + 1}")
     ax.set_title(f"layer {layer}: {len(counts)} nodes")
     return ax
 
 
-def plot_motion_tree_layers(tree, graphs=None, layers=None, *, graph=0, axes=(0, 1), min_probability=0.05):
+def plot_motion_tree_layers(
+    tree, graphs=None, layers=None, *, graph=0, axes=(0, 1), min_probability=0.05
+):
     """Several layers side by side (the paper's Figure 5 shows layers 4 and 7).
 
     Parameters
@@ -124,7 +143,9 @@ def plot_motion_tree_layers(tree, graphs=None, layers=None, *, graph=0, axes=(0,
         layers = sorted({max(1, bottom // 3), max(1, 2 * bottom // 3), bottom})
     fig, panels = plt.subplots(1, len(layers), figsize=(4.5 * len(layers), 4), squeeze=False)
     for ax, layer in zip(panels[0], layers):
-        plot_motion_tree_layer(tree, graphs, layer, graph=graph, axes=axes, min_probability=min_probability, ax=ax)
+        plot_motion_tree_layer(
+            tree, graphs, layer, graph=graph, axes=axes, min_probability=min_probability, ax=ax
+        )
     fig.tight_layout()
     return fig
 

@@ -36,7 +36,9 @@ def body_size(positions, chain):
     return float(np.median(steps, axis=0).sum())
 
 
-def body_frame_features(positions, *, frame_rate, root, left, right, up_axis="y", floor="lowest", size=1.0):
+def body_frame_features(
+    positions, *, frame_rate, root, left, right, up_axis="y", floor="lowest", size=1.0
+):
     """Positions and velocities of markers in the body frame, ``(n_frames, 6 * n_markers)``.
 
     For each frame the reference frame has its origin on the floor below the

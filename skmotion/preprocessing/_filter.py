@@ -168,7 +168,9 @@ class LowPassFilter(ClipTransformerMixin, BaseEstimator):
         self.n_jobs = n_jobs
 
     def __skmotion_tags__(self):
-        return MotionTags(output_kind="clips", min_frames=filter_min_frames(self.order, self.cutoff))
+        return MotionTags(
+            output_kind="clips", min_frames=filter_min_frames(self.order, self.cutoff)
+        )
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None):
@@ -205,7 +207,9 @@ class LowPassFilter(ClipTransformerMixin, BaseEstimator):
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
         out = parallel_map(
-            lambda c: lowpass_filter(c, order=self.order, cutoff=self.cutoff), clips, n_jobs=self.n_jobs
+            lambda c: lowpass_filter(c, order=self.order, cutoff=self.cutoff),
+            clips,
+            n_jobs=self.n_jobs,
         )
         return self._wrap_clips([np.asarray(o, dtype=c.dtype) for o, c in zip(out, clips)], clips)
 

@@ -14,8 +14,19 @@ __all__ = ["MARKER_NAMES", "MARKER_PRESETS", "detect_marker_preset", "marker_pre
 
 _CENTRE = ("head_top", "head", "neck", "chest", "spine", "pelvis")
 _SIDE = (
-    "clavicle", "shoulder", "upper_arm", "elbow", "forearm", "wrist", "hand",
-    "hip", "thigh", "knee", "shin", "ankle", "toe",
+    "clavicle",
+    "shoulder",
+    "upper_arm",
+    "elbow",
+    "forearm",
+    "wrist",
+    "hand",
+    "hip",
+    "thigh",
+    "knee",
+    "shin",
+    "ankle",
+    "toe",
 )
 #: The 32 marker names shared by every preset: 6 on the trunk and head, 13 per side.
 MARKER_NAMES = _CENTRE + tuple(f"{side}_{part}" for side in ("left", "right") for part in _SIDE)
@@ -47,8 +58,14 @@ def _limbs(joint, side):
 
 
 _CMU_PARTS = {
-    "clavicle": "clavicle", "shoulder": "humerus", "elbow": "radius", "wrist": "wrist",
-    "hip": "femur", "knee": "tibia", "ankle": "foot", "toe": "toes",
+    "clavicle": "clavicle",
+    "shoulder": "humerus",
+    "elbow": "radius",
+    "wrist": "wrist",
+    "hip": "femur",
+    "knee": "tibia",
+    "ankle": "foot",
+    "toe": "toes",
 }
 
 
@@ -60,8 +77,14 @@ def _cmu(part, side):
 
 
 _CC_PARTS = {
-    "clavicle": "Clavicle", "shoulder": "Upperarm", "elbow": "Forearm", "wrist": "Hand",
-    "hip": "Thigh", "knee": "Calf", "ankle": "Foot", "toe": "ToeBase",
+    "clavicle": "Clavicle",
+    "shoulder": "Upperarm",
+    "elbow": "Forearm",
+    "wrist": "Hand",
+    "hip": "Thigh",
+    "knee": "Calf",
+    "ankle": "Foot",
+    "toe": "ToeBase",
 }
 
 
@@ -73,8 +96,13 @@ def _cc(part, side):
 
 
 _BVH_PARTS = {
-    "clavicle": "Shoulder", "shoulder": "Arm", "elbow": "ForeArm", "wrist": "Hand",
-    "hip": "UpLeg", "knee": "Leg", "ankle": "Foot",
+    "clavicle": "Shoulder",
+    "shoulder": "Arm",
+    "elbow": "ForeArm",
+    "wrist": "Hand",
+    "hip": "UpLeg",
+    "knee": "Leg",
+    "ankle": "Foot",
 }
 
 
@@ -210,7 +238,9 @@ def _offset(skeleton, spec):
     if kind == "along":
         joint, child, fraction = spec[1:]
         if skeleton.parents[skeleton.joint_index(child)] != skeleton.joint_index(joint):
-            raise ValueError(f"Marker preset: {child!r} is not a child of {joint!r} in this skeleton.")
+            raise ValueError(
+                f"Marker preset: {child!r} is not a child of {joint!r} in this skeleton."
+            )
         return joint, fraction * np.asarray(skeleton.offsets[skeleton.joint_index(child)])
     joint, fraction, reference = spec[1:]
     bone = np.asarray(skeleton.offsets[skeleton.joint_index(joint)])
@@ -254,9 +284,13 @@ def marker_preset(skeleton, preset=None):
     if preset is None:
         preset = detect_marker_preset(skeleton)
     if preset not in _PRESETS:
-        raise ValueError(f"Unknown marker preset {preset!r}; expected one of {list(MARKER_PRESETS)}.")
+        raise ValueError(
+            f"Unknown marker preset {preset!r}; expected one of {list(MARKER_PRESETS)}."
+        )
     specs = _PRESETS[preset]
     missing = sorted(_required_joints(preset) - set(skeleton.joints))
     if missing:
-        raise ValueError(f"Marker preset {preset!r} needs joints {missing} that the skeleton does not have.")
+        raise ValueError(
+            f"Marker preset {preset!r} needs joints {missing} that the skeleton does not have."
+        )
     return MarkerSet([(name, *_offset(skeleton, specs[name])) for name in MARKER_NAMES])

@@ -75,7 +75,9 @@ class MarkerSet:
             raise ValueError(f"Marker names must be unique; {dup!r} appears twice.")
         offsets = np.array([np.asarray(m.offset, dtype=float) for m in rows])
         if offsets.shape != (len(rows), 3) or not np.isfinite(offsets).all():
-            raise ValueError(f"Each marker offset must be 3 finite numbers; got an array of shape {offsets.shape}.")
+            raise ValueError(
+                f"Each marker offset must be 3 finite numbers; got an array of shape {offsets.shape}."
+            )
         offsets.setflags(write=False)
         self.names = names
         self.joints = tuple(str(m.joint) for m in rows)
@@ -85,12 +87,17 @@ class MarkerSet:
         return len(self.names)
 
     def __iter__(self):
-        return (Marker(n, j, tuple(o)) for n, j, o in zip(self.names, self.joints, self.offsets.tolist()))
+        return (
+            Marker(n, j, tuple(o))
+            for n, j, o in zip(self.names, self.joints, self.offsets.tolist())
+        )
 
     def __eq__(self, other):
         if not isinstance(other, MarkerSet):
             return NotImplemented
-        return (self.names, self.joints) == (other.names, other.joints) and np.array_equal(self.offsets, other.offsets)
+        return (self.names, self.joints) == (other.names, other.joints) and np.array_equal(
+            self.offsets, other.offsets
+        )
 
     def __hash__(self):
         return hash((self.names, self.joints, self.offsets.tobytes()))
@@ -120,7 +127,11 @@ class MarkerSet:
             raise ValueError(
                 f"Marker {marker!r} is on joint {joint!r}, which the skeleton (root {skeleton.joints[0]!r}, "
                 f"{skeleton.n_joints} joints) does not have"
-                + (f"; {len(missing) - 1} more markers have unknown joints." if len(missing) > 1 else ".")
+                + (
+                    f"; {len(missing) - 1} more markers have unknown joints."
+                    if len(missing) > 1
+                    else "."
+                )
             )
         return np.array([index[j] for j in self.joints], dtype=np.intp)
 
@@ -139,4 +150,6 @@ class MarkerSet:
         """
         joints = self.joint_indices(skeleton)
         fk = forward_kinematics(skeleton, channels)
-        return fk.positions[:, joints] + np.einsum("fmij,mj->fmi", fk.rotations[:, joints], self.offsets)
+        return fk.positions[:, joints] + np.einsum(
+            "fmij,mj->fmi", fk.rotations[:, joints], self.offsets
+        )

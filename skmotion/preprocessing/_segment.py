@@ -356,11 +356,23 @@ def segment_clip(
             f"{what} needs frame_rate (frames per second); loaders report it, e.g. "
             "make_motions(...).frame_rate."
         )
-    signal = clip if filter_order is None else lowpass_filter(clip, order=filter_order, cutoff=filter_cutoff)
+    signal = (
+        clip
+        if filter_order is None
+        else lowpass_filter(clip, order=filter_order, cutoff=filter_cutoff)
+    )
     if rule == "zvc":
         return zvc_segments(
-            signal, frame_rate=frame_rate, window=zvc_window, min_channels=zvc_min_channels, min_movement=min_movement
+            signal,
+            frame_rate=frame_rate,
+            window=zvc_window,
+            min_channels=zvc_min_channels,
+            min_movement=min_movement,
         )
     return energy_segments(
-        signal, threshold=energy_threshold, ratio=energy_ratio, frame_rate=frame_rate, min_movement=min_movement
+        signal,
+        threshold=energy_threshold,
+        ratio=energy_ratio,
+        frame_rate=frame_rate,
+        min_movement=min_movement,
     )

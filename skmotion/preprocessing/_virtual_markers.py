@@ -264,14 +264,18 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
             if names is None:
                 names = clip_names
             elif clip_names != names:
-                raise ValueError(f"X: clip {i} gets markers {list(clip_names)[:5]}..., other clips {list(names)[:5]}...")
+                raise ValueError(
+                    f"X: clip {i} gets markers {list(clip_names)[:5]}..., other clips {list(names)[:5]}..."
+                )
             plans.append((skeleton, markers, frame_rate))
         return plans, names
 
     def _indices(self, names):
         root = self._index(names, self.root_marker, "root_marker")
         if len(self.facing_markers) != 2:
-            raise ValueError(f"facing_markers must be a (left, right) pair, got {self.facing_markers!r}.")
+            raise ValueError(
+                f"facing_markers must be a (left, right) pair, got {self.facing_markers!r}."
+            )
         left, right = (self._index(names, m, "facing marker") for m in self.facing_markers)
         if self.size_markers is None:
             chain = None
@@ -343,8 +347,14 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
                 raise ValueError(f"X: clip {i} has size 0 along size_markers; check the markers.")
             try:
                 return body_frame_features(
-                    positions, frame_rate=frame_rate, root=root, left=left, right=right,
-                    up_axis=up, floor=self.floor, size=size,
+                    positions,
+                    frame_rate=frame_rate,
+                    root=root,
+                    left=left,
+                    right=right,
+                    up_axis=up,
+                    floor=self.floor,
+                    size=size,
                 )
             except ValueError as exc:
                 raise ValueError(f"X: clip {i}: {exc}") from None
@@ -365,7 +375,9 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         feature_names_out : ndarray of str
         """
         check_is_fitted(self)
-        return np.asarray([f"{m}_{c}" for m in self.marker_names_ for c in _COMPONENTS], dtype=object)
+        return np.asarray(
+            [f"{m}_{c}" for m in self.marker_names_ for c in _COMPONENTS], dtype=object
+        )
 
 
 def to_markers(motions, transformer=None):
@@ -419,7 +431,9 @@ def to_markers(motions, transformer=None):
     motions = list(motions)
     bad = [i for i, m in enumerate(motions) if not isinstance(m, Motion)]
     if bad:
-        raise TypeError(f"motions: item {bad[0]} is a {type(motions[bad[0]]).__name__}, not a Motion.")
+        raise TypeError(
+            f"motions: item {bad[0]} is a {type(motions[bad[0]]).__name__}, not a Motion."
+        )
     groups = {}
     for i, motion in enumerate(motions):
         groups.setdefault(tuple(motion.channel_names), []).append(i)

@@ -47,8 +47,23 @@ def length_groups(lengths, n_graphs, budget=_GROUP_PAIRS):
     return groups
 
 
-def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, node_prior, score_layers=1, guide=None,
-                 normalise=True, prune=False, return_paths=True, n_jobs=None):
+def decode_clips(
+    tree,
+    graphs,
+    frames,
+    offsets,
+    *,
+    n_graphs,
+    layer,
+    n_paths,
+    node_prior,
+    score_layers=1,
+    guide=None,
+    normalise=True,
+    prune=False,
+    return_paths=True,
+    n_jobs=None,
+):
     """Beam-decode every clip under every graph (see :func:`beam_decode`).
 
     Parameters
@@ -78,8 +93,19 @@ def decode_clips(tree, graphs, frames, offsets, *, n_graphs, layer, n_paths, nod
         clip_of_problem = np.repeat(group, n_graphs)
         graph_of_problem = np.tile(np.arange(n_graphs), len(group))
         paths, scores = beam_decode(
-            tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, layer=layer, n_paths=n_paths,
-            score_layers=score_layers, node_prior=node_prior, guide=guide, normalise=normalise, prune=prune,
+            tree,
+            graphs,
+            frames,
+            offsets,
+            clip_of_problem,
+            graph_of_problem,
+            layer=layer,
+            n_paths=n_paths,
+            score_layers=score_layers,
+            node_prior=node_prior,
+            guide=guide,
+            normalise=normalise,
+            prune=prune,
             return_paths=return_paths,
         )
         if paths is not None:

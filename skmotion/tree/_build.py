@@ -67,7 +67,9 @@ class _Builder:
     """Breadth-first construction on a copy of the frames in which every node's
     frames are one contiguous block (splitting a node reorders its block)."""
 
-    def __init__(self, X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar):
+    def __init__(
+        self, X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar
+    ):
         # Rounding of a projection x @ axis is below d * eps * max|x|; cuts must
         # sit in gaps far wider, so a training frame always routes back to its side.
         self.tol = _GAP_RESOLUTION * X.shape[1] * max(float(X.max()), -float(X.min()))
@@ -80,14 +82,35 @@ class _Builder:
         self.min_leaf = min_samples_leaf
         self.split = split
         self.kind = covariance_type
-        self.nodes = {k: [] for k in ("parent", "depth", "start", "stop", "mean", "cov", "low_rank", "axis", "thr",
-                                      "left", "right")}
+        self.nodes = {
+            k: []
+            for k in (
+                "parent",
+                "depth",
+                "start",
+                "stop",
+                "mean",
+                "cov",
+                "low_rank",
+                "axis",
+                "thr",
+                "left",
+                "right",
+            )
+        }
 
     def add(self, parent, depth, start, stop):
         for key, value in zip(("parent", "depth", "start", "stop"), (parent, depth, start, stop)):
             self.nodes[key].append(value)
-        for key, value in (("left", -1), ("right", -1), ("axis", None), ("thr", np.nan), ("mean", None), ("cov", None),
-                           ("low_rank", None)):
+        for key, value in (
+            ("left", -1),
+            ("right", -1),
+            ("axis", None),
+            ("thr", np.nan),
+            ("mean", None),
+            ("cov", None),
+            ("low_rank", None),
+        ):
             self.nodes[key].append(value)
         return len(self.nodes["parent"]) - 1
 
@@ -104,7 +127,9 @@ class _Builder:
             self.root_scatter = scatter
         nodes["mean"][node] = mean
         nodes["cov"][node] = estimate_covariance(scatter, sq_norms, self.kind, self.reg)
-        if self.kind == "full" and n <= d:  # fewer frames than channels: the covariance is low rank plus a floor
+        if (
+            self.kind == "full" and n <= d
+        ):  # fewer frames than channels: the covariance is low rank plus a floor
             nodes["low_rank"][node] = low_rank_covariance(block - mean, scatter, sq_norms, self.reg)
         if not (may_split and n >= self.min_split):
             return ()
@@ -147,7 +172,9 @@ class _Builder:
         return layers
 
 
-def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar):
+def build_nodes(
+    X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar
+):
     """Grow the tree over validated frames; the per-node arrays and the layers.
 
     Parameters
@@ -170,7 +197,9 @@ def build_nodes(X, *, max_depth, min_samples_split, min_samples_leaf, split, cov
         ``principal_axes`` (the first three axes of all frames) and ``reg`` (the
         absolute regularisation): the arguments of ``MotionTree``.
     """
-    builder = _Builder(X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar)
+    builder = _Builder(
+        X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar
+    )
     layers = builder.run()
     nodes = builder.nodes
     d = X.shape[1]

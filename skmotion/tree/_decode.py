@@ -153,9 +153,16 @@ def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
     """What the compiled decoder reads of layers ``1 .. layer`` (entry 0 unused); see ``decode_searches``."""
     specs = [None]
     for depth in range(1, layer + 1):
-        specs.append((tree.kernel_children(depth - 1), tree.node_ids(depth), search.kernel_table(depth),
-                      scored.kernel_table(depth), _kernel_allowed(search, depth, node_prior),
-                      _kernel_allowed(scored, depth, node_prior) if mask_scored else _ALL_NODES))
+        specs.append(
+            (
+                tree.kernel_children(depth - 1),
+                tree.node_ids(depth),
+                search.kernel_table(depth),
+                scored.kernel_table(depth),
+                _kernel_allowed(search, depth, node_prior),
+                _kernel_allowed(scored, depth, node_prior) if mask_scored else _ALL_NODES,
+            )
+        )
     return specs
 
 
@@ -170,9 +177,18 @@ def _descend(tree, graphs, frames, frame_start, n_steps, graph, *, layer, n_path
         return np.zeros((int(n_steps.sum()), 1), dtype=np.intp)
     specs = _layer_specs(tree, graphs, graphs, layer, node_prior, False)
     _, _, beam = decode_searches(
-        np.ascontiguousarray(frames, dtype=np.float64), np.asarray(frame_start, dtype=np.intp), n_steps,
-        np.asarray(graph, dtype=np.intp), np.zeros(len(n_steps) + 1, dtype=np.intp), np.zeros(0, dtype=np.intp),
-        tree.kernel_gaussians(), specs, 1, n_paths, "beam", False,
+        np.ascontiguousarray(frames, dtype=np.float64),
+        np.asarray(frame_start, dtype=np.intp),
+        n_steps,
+        np.asarray(graph, dtype=np.intp),
+        np.zeros(len(n_steps) + 1, dtype=np.intp),
+        np.zeros(0, dtype=np.intp),
+        tree.kernel_gaussians(),
+        specs,
+        1,
+        n_paths,
+        "beam",
+        False,
     )
     return beam
 
@@ -183,12 +199,16 @@ def _clip_normalisers(tree, graphs, frames, offsets, clips, layers, node_prior):
     Only the frames of ``clips`` are evaluated.
     """
     starts, lengths = offsets[clips], offsets[clips + 1] - offsets[clips]
-    rows = np.repeat(starts - np.concatenate([[0], np.cumsum(lengths)[:-1]]), lengths) + np.arange(lengths.sum())
+    rows = np.repeat(starts - np.concatenate([[0], np.cumsum(lengths)[:-1]]), lengths) + np.arange(
+        lengths.sum()
+    )
     sub = frames[rows]
     bounds = np.concatenate([[0], np.cumsum(lengths)[:-1]])
     out = []
     for depth in layers:
-        norm = _log_normaliser(tree.log_likelihood(sub, depth), _allowed_nodes(graphs, depth, node_prior))
+        norm = _log_normaliser(
+            tree.log_likelihood(sub, depth), _allowed_nodes(graphs, depth, node_prior)
+        )
         sums = np.zeros((len(clips), norm.shape[1]))
         has = lengths > 0
         sums[has] = np.add.reduceat(norm, bounds[has], axis=0)
@@ -196,8 +216,23 @@ def _clip_normalisers(tree, graphs, frames, offsets, clips, layers, node_prior):
     return np.array(out)
 
 
-def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem, *, layer, n_paths=5,
-                score_layers=1, node_prior="graph", guide=None, normalise=True, prune=False, return_paths=True):
+def beam_decode(
+    tree,
+    graphs,
+    frames,
+    offsets,
+    clip_of_problem,
+    graph_of_problem,
+    *,
+    layer,
+    n_paths=5,
+    score_layers=1,
+    node_prior="graph",
+    guide=None,
+    normalise=True,
+    prune=False,
+    return_paths=True,
+):
     """Top-down beam Viterbi: the best node sequences of clips under graphs, layer by layer.
 
     Every frame starts at the root. Going one layer down, a frame's candidates
@@ -278,7 +313,9 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
     if not isinstance(score_layers, Integral) or isinstance(score_layers, bool) or score_layers < 1:
         raise ValueError(f"score_layers must be an int >= 1; got {score_layers!r}.")
     if prune and guide is None:
-        raise ValueError("prune needs a guide: the problems of a clip are compared within the clip's shared search.")
+        raise ValueError(
+            "prune needs a guide: the problems of a clip are compared within the clip's shared search."
+        )
     offsets = np.asarray(offsets, dtype=np.intp)
     clip_of_problem = np.asarray(clip_of_problem, dtype=np.intp)
     graph_of_problem = np.asarray(graph_of_problem, dtype=np.intp)
@@ -300,17 +337,39 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         score_graph = graph_of_problem
     else:  # one search per clip under the guide, shared by the clip's problems
         # (problems in clip order, as MotionTreeHMM gives them, need no reordering)
-        order = None if (np.diff(clip_of_problem) >= 0).all() else np.argsort(clip_of_problem, kind="stable")
+        order = (
+            None
+            if (np.diff(clip_of_problem) >= 0).all()
+            else np.argsort(clip_of_problem, kind="stable")
+        )
         search_clip, per_clip = np.unique(clip_of_problem, return_counts=True)
         search_graph, search = np.zeros(len(search_clip), dtype=np.intp), guide
         problem_start = np.concatenate([[0], np.cumsum(per_clip)]).astype(np.intp)
-        score_graph = graph_of_problem if order is None else np.ascontiguousarray(graph_of_problem[order])
+        score_graph = (
+            graph_of_problem if order is None else np.ascontiguousarray(graph_of_problem[order])
+        )
     specs = _layer_specs(tree, search, graphs, layer, node_prior, mask_scored=guide is not None)
     # One sequence and no paths: the forward pass alone gives its score.
-    mode = "best" if n_paths == 1 and not return_paths else "prune" if prune and n_paths > 1 else "kbest"
+    mode = (
+        "best"
+        if n_paths == 1 and not return_paths
+        else "prune"
+        if prune and n_paths > 1
+        else "kbest"
+    )
     scores, paths, _ = decode_searches(
-        frames, offsets[search_clip], lengths[search_clip], search_graph, problem_start, score_graph,
-        tree.kernel_gaussians(), specs, first, n_paths, mode, return_paths,
+        frames,
+        offsets[search_clip],
+        lengths[search_clip],
+        search_graph,
+        problem_start,
+        score_graph,
+        tree.kernel_gaussians(),
+        specs,
+        first,
+        n_paths,
+        mode,
+        return_paths,
     )
     if order is not None:
         back = np.empty_like(order)
@@ -319,7 +378,9 @@ def beam_decode(tree, graphs, frames, offsets, clip_of_problem, graph_of_problem
         paths = paths[back] if return_paths else None
     if normalise and n_problems:
         clips, inverse = np.unique(clip_of_problem, return_inverse=True)
-        sums = _clip_normalisers(tree, graphs, frames, offsets, clips, range(first, layer + 1), node_prior)
+        sums = _clip_normalisers(
+            tree, graphs, frames, offsets, clips, range(first, layer + 1), node_prior
+        )
         column = graph_of_problem if sums.shape[2] > 1 else np.zeros(n_problems, dtype=np.intp)
         scores -= sums[:, inverse, column].T[:, :, None]
     return paths, scores

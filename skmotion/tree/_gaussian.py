@@ -13,8 +13,14 @@ change; its covariance must still be invertible. Three estimators are offered:
 import numpy as np
 from scipy.linalg import solve_triangular
 
-__all__ = ["COVARIANCE_TYPES", "Gaussians", "centred_moments", "estimate_covariance", "ledoit_wolf_shrinkage",
-           "low_rank_covariance"]
+__all__ = [
+    "COVARIANCE_TYPES",
+    "Gaussians",
+    "centred_moments",
+    "estimate_covariance",
+    "ledoit_wolf_shrinkage",
+    "low_rank_covariance",
+]
 
 #: The covariance estimators of :func:`estimate_covariance`.
 COVARIANCE_TYPES = ("diag", "full", "spherical")
@@ -283,7 +289,9 @@ class Gaussians:
         start, rank = np.full(n, -1, dtype=np.intp), np.zeros(n, dtype=np.intp)
         inv_floor = np.zeros(n)
         vectors, weights, row = [np.zeros((0, d))], [np.zeros(0)], 0
-        for k, parts in enumerate(self.low_rank if self.kind == "full" and self.low_rank is not None else ()):
+        for k, parts in enumerate(
+            self.low_rank if self.kind == "full" and self.low_rank is not None else ()
+        ):
             if parts is None or 4 * (len(parts[1]) + 2) > d:  # the triangular factor is as cheap
                 continue
             floor, vecs, values = parts

@@ -263,7 +263,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         clips = check_clips(X, estimator=self, reset=True)
         y = column_or_1d(np.asarray(y), warn=True)
         if len(y) != len(clips):
-            raise ValueError(f"y has {len(y)} labels but X holds {len(clips)} clips; give one label per clip.")
+            raise ValueError(
+                f"y has {len(y)} labels but X holds {len(clips)} clips; give one label per clip."
+            )
         check_classification_targets(y)
         self.classes_, y_index = np.unique(y, return_inverse=True)
         frames, offsets = stack_clips(clips)
@@ -284,21 +286,35 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             reg_covar=self.reg_covar,
         )
         self.layer_ = tree.check_layer(-1 if self.layer is None else self.layer)
-        n_scored = self.layer_ if self.score_layers == "all" else min(self.score_layers, self.layer_)
-        self.score_layers_ = np.arange(self.layer_ - n_scored + 1, self.layer_ + 1) if self.layer_ else np.zeros(1, int)
+        n_scored = (
+            self.layer_ if self.score_layers == "all" else min(self.score_layers, self.layer_)
+        )
+        self.score_layers_ = (
+            np.arange(self.layer_ - n_scored + 1, self.layer_ + 1)
+            if self.layer_
+            else np.zeros(1, int)
+        )
         labels = list(tree.iter_apply(frames))
         n_clips = len(clips)
         self.global_graph_ = TransitionGraphs.count(
-            labels, tree.n_nodes, offsets=offsets, graph_of_clip=np.zeros(n_clips, dtype=np.intp),
-            n_graphs=1, smoothing=self.smoothing,
+            labels,
+            tree.n_nodes,
+            offsets=offsets,
+            graph_of_clip=np.zeros(n_clips, dtype=np.intp),
+            n_graphs=1,
+            smoothing=self.smoothing,
         )
         if self.graph == "class":
             graph_of_clip, self.graph_classes_ = y_index, np.arange(len(self.classes_))
         else:
             graph_of_clip, self.graph_classes_ = np.arange(n_clips), y_index
         self.graphs_ = TransitionGraphs.count(
-            labels, tree.n_nodes, offsets=offsets, graph_of_clip=graph_of_clip,
-            n_graphs=len(self.graph_classes_), smoothing=self.smoothing,
+            labels,
+            tree.n_nodes,
+            offsets=offsets,
+            graph_of_clip=graph_of_clip,
+            n_graphs=len(self.graph_classes_),
+            smoothing=self.smoothing,
         )
         self.tree_ = tree
         self.n_layers_ = tree.n_layers
@@ -307,7 +323,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     # -- decoding ------------------------------------------------------------------
 
-    def _decode(self, clips, graphs, layer, n_graphs, *, score_layers=1, exact=True, prune=False, paths=True):
+    def _decode(
+        self, clips, graphs, layer, n_graphs, *, score_layers=1, exact=True, prune=False, paths=True
+    ):
         """Beam-decode every clip under every graph: paths and scores per clip (see ``decode_clips``).
 
         Without ``exact``, and when the normaliser of ``Ps`` is the same for
@@ -322,9 +340,20 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         guide = self.global_graph_ if self.node_prior == "layer" else None
         frames, offsets = stack_clips(clips)
         return decode_clips(
-            self.tree_, graphs, (frames - self.center_) / self.scale_, offsets, n_graphs=n_graphs, layer=layer,
-            n_paths=self.n_paths, node_prior=self.node_prior, score_layers=score_layers, guide=guide,
-            normalise=normalise, prune=prune and guide is not None, return_paths=paths, n_jobs=self.n_jobs,
+            self.tree_,
+            graphs,
+            (frames - self.center_) / self.scale_,
+            offsets,
+            n_graphs=n_graphs,
+            layer=layer,
+            n_paths=self.n_paths,
+            node_prior=self.node_prior,
+            score_layers=score_layers,
+            guide=guide,
+            normalise=normalise,
+            prune=prune and guide is not None,
+            return_paths=paths,
+            n_jobs=self.n_jobs,
         )
 
     def _class_log_probs(self, clips, exact=True, prune=False):
@@ -334,8 +363,16 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         per clip (enough to rank classes). With ``prune``, ``-inf`` for classes
         that provably do not score best.
         """
-        _, scores = self._decode(clips, self.graphs_, self.layer_, len(self.graph_classes_),
-                                 score_layers=len(self.score_layers_), exact=exact, prune=prune, paths=False)
+        _, scores = self._decode(
+            clips,
+            self.graphs_,
+            self.layer_,
+            len(self.graph_classes_),
+            score_layers=len(self.score_layers_),
+            exact=exact,
+            prune=prune,
+            paths=False,
+        )
         per_graph = _sum_of_paths(scores).sum(axis=2)
         if self.graph == "class":
             return per_graph
@@ -440,7 +477,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
-        paths, _ = self._decode(clips, self.global_graph_, self._resolve_layer(layer), 1, exact=False)
+        paths, _ = self._decode(
+            clips, self.global_graph_, self._resolve_layer(layer), 1, exact=False
+        )
         return [p[0, 0] for p in paths]
 
     def predict_next(self, X, n_steps=1, *, n_best=3, layer=None):
@@ -493,9 +532,23 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             layer=layer,
         )
 
-    def plan(self, start, goal, *, frame_rate, body_size=None, transformer=None, layer=None, max_frames=300,
-             tolerance=0.1, start_node=None, heuristic_weight=8.0, cell=0.05, heading_bins=36,
-             max_expansions=500_000):
+    def plan(
+        self,
+        start,
+        goal,
+        *,
+        frame_rate,
+        body_size=None,
+        transformer=None,
+        layer=None,
+        max_frames=300,
+        tolerance=0.1,
+        start_node=None,
+        heuristic_weight=8.0,
+        cell=0.05,
+        heading_bins=36,
+        max_expansions=500_000,
+    ):
         """Plan a motion on the global transition graph that takes the root from ``start`` to ``goal``.
 
         A* over (node, root pose on the floor) finds the most probable node
@@ -588,8 +641,12 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             raise ValueError(f"start must be a finite (x, y, heading); got {start.tolist()!r}.")
         if goal.shape != (2,) or not np.isfinite(goal).all():
             raise ValueError(f"goal must be a finite (x, y); got {goal.tolist()!r}.")
-        for name, value in (("frame_rate", frame_rate), ("tolerance", tolerance), ("cell", cell),
-                            ("heuristic_weight", heuristic_weight)):
+        for name, value in (
+            ("frame_rate", frame_rate),
+            ("tolerance", tolerance),
+            ("cell", cell),
+            ("heuristic_weight", heuristic_weight),
+        ):
             if not isinstance(value, Real) or not value > 0:
                 raise ValueError(f"{name} must be a positive number; got {value!r}.")
         if heuristic_weight < 1:
@@ -602,7 +659,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         if start_node is not None:
             start_node = _check_count("start_node", start_node, low=0)
             if start_node >= n_nodes:
-                raise ValueError(f"start_node must be below {n_nodes}, the nodes of layer {layer}; got {start_node}.")
+                raise ValueError(
+                    f"start_node must be below {n_nodes}, the nodes of layer {layer}; got {start_node}."
+                )
         model = None
         if transformer is not None:
             check_is_fitted(transformer)
@@ -616,13 +675,25 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         if body_size is None:
             body_size = default_body_size(model) or 1.0
         elif not isinstance(body_size, Real) or not body_size > 0:
-            raise ValueError(f"body_size must be a positive number (metres per data unit); got {body_size!r}.")
+            raise ValueError(
+                f"body_size must be a positive number (metres per data unit); got {body_size!r}."
+            )
         graph = self.global_graph_
         return plan_motion(
             self.tree_.means(layer) * self.scale_ + self.center_,
             (graph.counts(layer, 0), lambda src, dst: graph.log_prob(layer, 0, src, dst)),
-            graph.visits(layer)[0], tuple(start), tuple(goal), frame_rate=float(frame_rate),
-            body_size=float(body_size), max_frames=max_frames, tolerance=float(tolerance), start_node=start_node,
-            model=model, heuristic_weight=float(heuristic_weight), cell=float(cell), heading_bins=heading_bins,
-            max_expansions=max_expansions, layer=layer,
+            graph.visits(layer)[0],
+            tuple(start),
+            tuple(goal),
+            frame_rate=float(frame_rate),
+            body_size=float(body_size),
+            max_frames=max_frames,
+            tolerance=float(tolerance),
+            start_node=start_node,
+            model=model,
+            heuristic_weight=float(heuristic_weight),
+            cell=float(cell),
+            heading_bins=heading_bins,
+            max_expansions=max_expansions,
+            layer=layer,
         )

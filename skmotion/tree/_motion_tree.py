@@ -22,7 +22,9 @@ def _check_int(name, value, low, allow_none=False):
     if allow_none and value is None:
         return
     if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
-        raise ValueError(f"{name} must be an int >= {low}{' or None' if allow_none else ''}; got {value!r}.")
+        raise ValueError(
+            f"{name} must be an int >= {low}{' or None' if allow_none else ''}; got {value!r}."
+        )
 
 
 class MotionTree:
@@ -82,8 +84,24 @@ class MotionTree:
     True
     """
 
-    def __init__(self, *, parent, left, right, depth, count, mean, covariance, axis, threshold, layers,
-                 covariance_type, reg, principal_axes, low_rank=None):
+    def __init__(
+        self,
+        *,
+        parent,
+        left,
+        right,
+        depth,
+        count,
+        mean,
+        covariance,
+        axis,
+        threshold,
+        layers,
+        covariance_type,
+        reg,
+        principal_axes,
+        low_rank=None,
+    ):
         self.parent = parent
         self.left = left
         self.right = right
@@ -99,11 +117,22 @@ class MotionTree:
         self.principal_axes = principal_axes
         self.low_rank = [None] * len(parent) if low_rank is None else low_rank
         self._gaussians = Gaussians(mean, covariance, covariance_type, self.low_rank)
-        self._kernel_children = [np.ascontiguousarray(self.children(layer)) for layer in range(len(layers))]
+        self._kernel_children = [
+            np.ascontiguousarray(self.children(layer)) for layer in range(len(layers))
+        ]
 
     @classmethod
-    def build(cls, frames, *, max_depth=None, min_samples_split=2, min_samples_leaf=16, split="min_error",
-              covariance_type="diag", reg_covar=1e-6):
+    def build(
+        cls,
+        frames,
+        *,
+        max_depth=None,
+        min_samples_split=2,
+        min_samples_leaf=16,
+        split="min_error",
+        covariance_type="diag",
+        reg_covar=1e-6,
+    ):
         """Build the tree over frames.
 
         Parameters
@@ -136,22 +165,34 @@ class MotionTree:
         """
         X = np.asarray(frames, dtype=np.float64)
         if X.ndim != 2 or len(X) == 0 or X.shape[1] == 0:
-            raise ValueError(f"frames must be a non-empty 2-D array (n_frames, n_channels); got shape {X.shape}.")
+            raise ValueError(
+                f"frames must be a non-empty 2-D array (n_frames, n_channels); got shape {X.shape}."
+            )
         if not np.isfinite(X).all():
             frame, channel = np.argwhere(~np.isfinite(X))[0]
-            raise ValueError(f"frames must be finite; frame {frame}, channel {channel} is {X[frame, channel]}.")
+            raise ValueError(
+                f"frames must be finite; frame {frame}, channel {channel} is {X[frame, channel]}."
+            )
         _check_int("max_depth", max_depth, 0, allow_none=True)
         _check_int("min_samples_split", min_samples_split, 2)
         _check_int("min_samples_leaf", min_samples_leaf, 1)
         if split not in SPLIT_CRITERIA:
             raise ValueError(f"split must be one of {SPLIT_CRITERIA}; got {split!r}.")
         if covariance_type not in COVARIANCE_TYPES:
-            raise ValueError(f"covariance_type must be one of {COVARIANCE_TYPES}; got {covariance_type!r}.")
+            raise ValueError(
+                f"covariance_type must be one of {COVARIANCE_TYPES}; got {covariance_type!r}."
+            )
         if not isinstance(reg_covar, Real) or not reg_covar > 0:
             raise ValueError(f"reg_covar must be a positive number; got {reg_covar!r}.")
-        nodes = build_nodes(np.ascontiguousarray(X), max_depth=max_depth, min_samples_split=min_samples_split,
-                            min_samples_leaf=min_samples_leaf, split=split, covariance_type=covariance_type,
-                            reg_covar=reg_covar)
+        nodes = build_nodes(
+            np.ascontiguousarray(X),
+            max_depth=max_depth,
+            min_samples_split=min_samples_split,
+            min_samples_leaf=min_samples_leaf,
+            split=split,
+            covariance_type=covariance_type,
+            reg_covar=reg_covar,
+        )
         return cls(**nodes, covariance_type=covariance_type)
 
     # -- sizes and layer structure ------------------------------------------------

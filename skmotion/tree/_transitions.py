@@ -76,9 +76,14 @@ class TransitionGraphs:
         self._visits = [np.asarray(v, dtype=np.int64) for v in visits]
         self.n_layers = len(self._counts)
         self.n_graphs = len(self._visits[0]) if self.n_layers else 0
-        self._totals = [np.asarray(c.sum(axis=1)).ravel().reshape(self.n_graphs, -1) for c in self._counts]
+        self._totals = [
+            np.asarray(c.sum(axis=1)).ravel().reshape(self.n_graphs, -1) for c in self._counts
+        ]
         self._dense = [self._dense_log(layer) for layer in range(self.n_layers)]
-        self._keys = [None if d is not None else self._sorted_keys(layer) for layer, d in enumerate(self._dense)]
+        self._keys = [
+            None if d is not None else self._sorted_keys(layer)
+            for layer, d in enumerate(self._dense)
+        ]
         self._kernel = [self._kernel_table(layer) for layer in range(self.n_layers)]
 
     @classmethod
@@ -119,8 +124,14 @@ class TransitionGraphs:
             labels = np.asarray(labels, dtype=np.intp)
             rows = graph_of_frame[src_frames] * k + labels[src_frames]
             data = np.ones(len(rows), dtype=np.int64)
-            counts.append(sp.csr_matrix((data, (rows, labels[src_frames + 1])), shape=(n_graphs * k, k)))
-            visits.append(np.bincount(graph_of_frame * k + labels, minlength=n_graphs * k).reshape(n_graphs, k))
+            counts.append(
+                sp.csr_matrix((data, (rows, labels[src_frames + 1])), shape=(n_graphs * k, k))
+            )
+            visits.append(
+                np.bincount(graph_of_frame * k + labels, minlength=n_graphs * k).reshape(
+                    n_graphs, k
+                )
+            )
         return cls(counts, visits, smoothing)
 
     def _dense_log(self, layer):
@@ -182,7 +193,9 @@ class TransitionGraphs:
         pairs, pair_of_entry = np.unique(src * k + csr.indices, return_inverse=True)
         pair_src, pair_dst = np.divmod(pairs, k)
         pair_log = np.ascontiguousarray(unseen[:, pair_src].T)
-        pair_log[pair_of_entry, graph] = np.log((csr.data + self.pseudo_count(layer)) / denominator[graph, src])
+        pair_log[pair_of_entry, graph] = np.log(
+            (csr.data + self.pseudo_count(layer)) / denominator[graph, src]
+        )
         small = n_graphs * (k + 1) ** 2 <= _KERNEL_DENSE_LIMIT and self._dense[layer] is not None
         return {
             "k": k,
@@ -190,7 +203,9 @@ class TransitionGraphs:
             "pair_start": np.searchsorted(pair_src, np.arange(k + 1)).astype(np.intp),
             "pair_dst": pair_dst.astype(np.intp),
             "pair_log": pair_log,
-            "unseen_log": np.ascontiguousarray(np.vstack([unseen.T, np.full((1, n_graphs), -np.inf)])),
+            "unseen_log": np.ascontiguousarray(
+                np.vstack([unseen.T, np.full((1, n_graphs), -np.inf)])
+            ),
             "dense": self._dense[layer] if small else np.zeros(0),
         }
 

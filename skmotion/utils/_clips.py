@@ -88,8 +88,7 @@ def _describe_bad_value(clip, clip_index, input_name):
     n_bad = int(bad.sum())
     more = f" ({n_bad} non-finite values in this clip)" if n_bad > 1 else ""
     return (
-        f"{input_name}: clip {clip_index} contains {what} at frame {frame}, "
-        f"channel {channel}{more}"
+        f"{input_name}: clip {clip_index} contains {what} at frame {frame}, channel {channel}{more}"
     )
 
 
@@ -104,16 +103,13 @@ def _as_float_clip(clip, clip_index, dtype, input_name):
         clip = clip.to_numpy()
     arr = np.asarray(clip)
     if arr.dtype.kind == "c":
-        raise ValueError(
-            f"{input_name}: clip {clip_index} has complex values; clips must be real."
-        )
+        raise ValueError(f"{input_name}: clip {clip_index} has complex values; clips must be real.")
     if arr.dtype.kind not in "biuf":
         try:
             arr = arr.astype(np.float64)
         except (TypeError, ValueError) as exc:
             raise ValueError(
-                f"{input_name}: clip {clip_index} has non-numeric data "
-                f"(dtype {arr.dtype}): {exc}"
+                f"{input_name}: clip {clip_index} has non-numeric data (dtype {arr.dtype}): {exc}"
             ) from None
     target = arr.dtype if arr.dtype in dtype else dtype[0]
     return arr, target
@@ -236,7 +232,9 @@ def _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name)
         if not np.isfinite(np.add.reduce(arr, axis=None)):
             if allow_nan:
                 if np.isinf(arr).any():
-                    raise ValueError(_describe_bad_value(np.where(np.isnan(arr), 0, arr), i, input_name))
+                    raise ValueError(
+                        _describe_bad_value(np.where(np.isnan(arr), 0, arr), i, input_name)
+                    )
             elif not np.isfinite(arr).all():
                 raise ValueError(
                     _describe_bad_value(arr, i, input_name)
@@ -330,11 +328,7 @@ def check_clips(
                 "2-D arrays, a 3-D array or a (clip, frame) DataFrame."
             )
         if X.ndim != 3:
-            hint = (
-                " For a single clip pass [clip]."
-                if X.ndim == 2
-                else ""
-            )
+            hint = " For a single clip pass [clip]." if X.ndim == 2 else ""
             raise ValueError(
                 f"{input_name} is a {X.ndim}-D array of shape {X.shape}; a clip "
                 "collection is a list of 2-D arrays (n_frames, n_channels), a 3-D "
@@ -358,8 +352,12 @@ def check_clips(
             f"{input_name} holds {len(raw)} clip(s); {name} needs at least {min_clips}."
         )
 
-    with np.errstate(over="ignore", invalid="ignore"):  # the finite check sums the values, see below
-        clips, n_channels = _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name)
+    with np.errstate(
+        over="ignore", invalid="ignore"
+    ):  # the finite check sums the values, see below
+        clips, n_channels = _check_each_clip(
+            raw, dtypes, min_frames, allow_nan, copy, name, input_name
+        )
 
     if estimator is not None:
         if reset:
@@ -419,7 +417,9 @@ def to_container(clips, container, *, columns=None):
         lengths = {c.shape for c in clips}
         return np.stack(clips) if len(lengths) == 1 else list(clips)
     if kind != "dataframe":
-        raise ValueError(f"Unknown container kind {kind!r}; expected one of {sorted(CONTAINER_KINDS)}.")
+        raise ValueError(
+            f"Unknown container kind {kind!r}; expected one of {sorted(CONTAINER_KINDS)}."
+        )
     n_channels = clips[0].shape[1] if len(clips) else 0
     if columns is None:
         if container.columns is not None and len(container.columns) == n_channels:
@@ -432,7 +432,10 @@ def to_container(clips, container, *, columns=None):
     names = container.index_names or ("clip", "frame")
     lengths = [len(c) for c in clips]
     index = pd.MultiIndex.from_arrays(
-        [np.repeat(np.asarray(labels, dtype=object), lengths), np.concatenate([np.arange(n) for n in lengths])],
+        [
+            np.repeat(np.asarray(labels, dtype=object), lengths),
+            np.concatenate([np.arange(n) for n in lengths]),
+        ],
         names=[_check_index_name(names[0], "clip"), _check_index_name(names[1], "frame")],
     )
     values = np.concatenate(clips) if clips else np.empty((0, n_channels))

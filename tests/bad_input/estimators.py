@@ -5,23 +5,33 @@ Each entry builds a fresh estimator and its fit data: a list of clips and labels
 """
 
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cache
 
 from skmotion.control import KMeansPrimitiveController
 from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
 from skmotion.neighbors import IntervalIndexNeighbors
-from skmotion.preprocessing import FlattenClips, LowPassFilter, ResampleClips, VirtualMarkerTransform
+from skmotion.preprocessing import (
+    FlattenClips,
+    LowPassFilter,
+    ResampleClips,
+    VirtualMarkerTransform,
+)
 from skmotion.tree import MotionTreeHMM
 from tests.decomposition.test_eigenmovements import stroke_clips
 
 OUTPUT_METHODS = ("predict", "predict_proba", "score_samples", "decode", "transform", "kneighbors")
 
 
-@lru_cache(maxsize=None)
+@cache
 def _motions():
-    data = make_motions(n_clips_per_class=3, n_subjects=3, classes=["walk", "wave", "squat"],
-                        duration=(0.6, 0.9), random_state=0)
+    data = make_motions(
+        n_clips_per_class=3,
+        n_subjects=3,
+        classes=["walk", "wave", "squat"],
+        duration=(0.6, 0.9),
+        random_state=0,
+    )
     return tuple(data.clips), data.target_names[data.target]
 
 
@@ -45,7 +55,7 @@ def strokes():
     return stroke_clips(6, seed=0), None
 
 
-@lru_cache(maxsize=None)
+@cache
 def _codes():
     clips, _ = strokes()
     return tuple(EigenMovementPCA(3, n_samples=20).fit_transform(clips))
@@ -70,12 +80,27 @@ SKELETON = humanoid_skeleton()
 ENTRIES = {
     e.name: e
     for e in [
-        Entry("MotionTreeHMM", lambda: MotionTreeHMM(max_depth=3, min_samples_leaf=4), without_root, True),
-        Entry("IntervalIndexNeighbors", lambda: IntervalIndexNeighbors(n_levels=2), without_root, True),
+        Entry(
+            "MotionTreeHMM",
+            lambda: MotionTreeHMM(max_depth=3, min_samples_leaf=4),
+            without_root,
+            True,
+        ),
+        Entry(
+            "IntervalIndexNeighbors", lambda: IntervalIndexNeighbors(n_levels=2), without_root, True
+        ),
         Entry("SVDFeatureExtractor", lambda: SVDFeatureExtractor(n_components=3), without_root),
         Entry("EigenMovementPCA", lambda: EigenMovementPCA(3, n_samples=20), strokes),
-        Entry("KMeansPrimitiveController", lambda: KMeansPrimitiveController(3, n_init=1, random_state=0), codes),
-        Entry("VirtualMarkerTransform", lambda: VirtualMarkerTransform(SKELETON, frame_rate=30.0), joint_angles),
+        Entry(
+            "KMeansPrimitiveController",
+            lambda: KMeansPrimitiveController(3, n_init=1, random_state=0),
+            codes,
+        ),
+        Entry(
+            "VirtualMarkerTransform",
+            lambda: VirtualMarkerTransform(SKELETON, frame_rate=30.0),
+            joint_angles,
+        ),
         Entry("ResampleClips", lambda: ResampleClips(n_frames=8), without_root),
         Entry("FlattenClips", FlattenClips, equal_length),
         Entry("LowPassFilter", lambda: LowPassFilter(order=2), without_root),

@@ -16,7 +16,9 @@ from tests.io.test_asf_amc import ASF, _amc, _frames
 
 def written_bvh(folder, n_frames=8):
     """A make_motions clip written by write_bvh (a 26-joint humanoid)."""
-    clip = make_motions(n_clips_per_class=1, classes=["walk"], n_subjects=1, random_state=0).clips[0][:n_frames]
+    clip = make_motions(n_clips_per_class=1, classes=["walk"], n_subjects=1, random_state=0).clips[
+        0
+    ][:n_frames]
     path = Path(folder) / "written.bvh"
     write_bvh(Motion(humanoid_skeleton(), clip, frame_rate=30.0), path, precision=4)
     return path.read_bytes()

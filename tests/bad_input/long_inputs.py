@@ -8,7 +8,9 @@ from skmotion.tree import MotionTreeHMM
 from tests.io.test_asf_amc import ASF
 
 # The toy ASF skeleton's AMC frame: its number, then root (6), femur (3), tibia (2), back (1).
-_AMC_FRAME = "%d\nroot" + " %.6f" * 6 + "\nfemur" + " %.6f" * 3 + "\ntibia" + " %.6f" * 2 + "\nback %.6f"
+_AMC_FRAME = (
+    "%d\nroot" + " %.6f" * 6 + "\nfemur" + " %.6f" * 3 + "\ntibia" + " %.6f" * 2 + "\nback %.6f"
+)
 
 
 def fitted_hmm(max_depth=3):

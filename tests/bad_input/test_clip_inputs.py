@@ -45,9 +45,24 @@ def _objects(X):
 CLIP_CASES = [
     ("empty list", lambda X: [], ValueError, "X is an empty collection"),
     ("empty tuple", lambda X: (), ValueError, "X is an empty collection"),
-    ("empty 3-D array", lambda X: np.empty((0, 5, X[0].shape[1])), ValueError, "X is an empty collection"),
-    ("clip with zero frames", lambda X: _replace(X, 1, X[1][:0]), ValueError, "clip 1 has no frames"),
-    ("clip with zero channels", lambda X: _replace(X, 1, X[1][:, :0]), ValueError, "clip 1 has no channels"),
+    (
+        "empty 3-D array",
+        lambda X: np.empty((0, 5, X[0].shape[1])),
+        ValueError,
+        "X is an empty collection",
+    ),
+    (
+        "clip with zero frames",
+        lambda X: _replace(X, 1, X[1][:0]),
+        ValueError,
+        "clip 1 has no frames",
+    ),
+    (
+        "clip with zero channels",
+        lambda X: _replace(X, 1, X[1][:, :0]),
+        ValueError,
+        "clip 1 has no channels",
+    ),
     ("different channel counts", lambda X: _replace(X, 2, X[2][:, :-1]), ValueError, "clip 2 has"),
     ("NaN", _poke(np.nan), ValueError, "clip 1 contains NaN at frame 2, channel 0"),
     ("inf", _poke(np.inf), ValueError, "clip 1 contains inf at frame 2, channel 0"),
@@ -55,15 +70,30 @@ CLIP_CASES = [
     ("object array with a word", _objects, ValueError, "clip 1 has non-numeric data"),
     # (an array of numeric strings is converted, by design: see tests/utils/test_clips.py)
     ("string array with a word", _words, ValueError, "clip 1 has non-numeric data"),
-    ("complex clip", lambda X: _replace(X, 1, np.asarray(X[1]) + 1j), ValueError, "clip 1 has complex values"),
+    (
+        "complex clip",
+        lambda X: _replace(X, 1, np.asarray(X[1]) + 1j),
+        ValueError,
+        "clip 1 has complex values",
+    ),
     ("1-D clip", lambda X: _replace(X, 0, np.asarray(X[0])[:, 0]), ValueError, "clip 0 is 1-D"),
     ("3-D clip", lambda X: _replace(X, 0, np.asarray(X[0])[None]), ValueError, "clip 0 is 3-D"),
     ("a single 2-D clip", lambda X: np.asarray(X[0]), ValueError, "For a single clip pass [clip]"),
-    ("sparse clip", lambda X: _replace(X, 0, sp.csr_matrix(np.asarray(X[0]))), TypeError, "clip 0 is a sparse matrix"),
+    (
+        "sparse clip",
+        lambda X: _replace(X, 0, sp.csr_matrix(np.asarray(X[0]))),
+        TypeError,
+        "clip 0 is a sparse matrix",
+    ),
     ("dict", lambda X: dict(enumerate(X)), TypeError, "got dict"),
     ("None", lambda X: None, TypeError, "got NoneType"),
     ("a string", lambda X: "walk.bvh", TypeError, "got str"),
-    ("flat DataFrame", lambda X: pd.DataFrame(np.asarray(X[0])), ValueError, "two-level (clip, frame) MultiIndex"),
+    (
+        "flat DataFrame",
+        lambda X: pd.DataFrame(np.asarray(X[0])),
+        ValueError,
+        "two-level (clip, frame) MultiIndex",
+    ),
 ]
 
 # Inputs that are valid for one estimator: KMeansPrimitiveController takes segment
@@ -93,7 +123,9 @@ def _cases(stage):
                 continue
             if name == "IntervalIndexNeighbors":
                 error, fragment = TABLE_OVERRIDES.get((stage, case_id), (error, fragment))
-            yield pytest.param(entry, case_id, make_bad, error, fragment, id=f"{name}-{stage}-{case_id}")
+            yield pytest.param(
+                entry, case_id, make_bad, error, fragment, id=f"{name}-{stage}-{case_id}"
+            )
 
 
 def _check(error, fragment, call):

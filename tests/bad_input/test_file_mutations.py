@@ -30,7 +30,11 @@ _NUMBER = re.compile(rb"(?<![\w.])-?\d+(\.\d+)?([eE][-+]?\d+)?(?![\w.])")
 def mutations(draw, data):
     """(description, mutated bytes) of one random edit of ``data``."""
     lines = data.split(b"\n")
-    kind = draw(st.sampled_from(["truncate", "delete line", "duplicate line", "number to word", "drop brace"]))
+    kind = draw(
+        st.sampled_from(
+            ["truncate", "delete line", "duplicate line", "number to word", "drop brace"]
+        )
+    )
     if kind == "truncate":
         cut = draw(st.integers(0, len(data) - 1))
         return f"truncate at byte {cut}", data[:cut]
@@ -38,9 +42,11 @@ def mutations(draw, data):
         i = draw(st.integers(0, len(lines) - 1))
         edited = lines[:i] + lines[i + 1 :] if kind == "delete line" else lines[: i + 1] + lines[i:]
         return f"{kind} {i + 1}", b"\n".join(edited)
-    spans = [m.span() for m in _NUMBER.finditer(data)] if kind == "number to word" else [
-        (m.start(), m.end()) for m in re.finditer(rb"[{}]", data)
-    ]
+    spans = (
+        [m.span() for m in _NUMBER.finditer(data)]
+        if kind == "number to word"
+        else [(m.start(), m.end()) for m in re.finditer(rb"[{}]", data)]
+    )
     if not spans:
         return "unchanged", data
     start, end = draw(st.sampled_from(spans))
@@ -112,7 +118,9 @@ def check_ts(result, text):
     assert len(clips) == len(data)
     for clip, line in zip(clips, data):
         fields = line.split(":")[: clip.shape[1]]
-        expected = np.array([[float(v.replace("?", "nan")) for v in f.split(",")] for f in fields]).T
+        expected = np.array(
+            [[float(v.replace("?", "nan")) for v in f.split(",")] for f in fields]
+        ).T
         np.testing.assert_array_equal(clip, expected)
         assert not np.isinf(clip).any()
     if labels is not None:
@@ -130,13 +138,17 @@ def read_mutated(tmp_path, kind, read, description, data):
         result = read(path)
     except MotionFileError as error:
         assert str(error).startswith(str(path)), error
-        assert error.line is None or 1 <= error.line <= data.count(b"\n") + 1, f"{description}: line {error.line}"
+        assert error.line is None or 1 <= error.line <= data.count(b"\n") + 1, (
+            f"{description}: line {error.line}"
+        )
         return "MotionFileError"
     text = data.decode("latin-1")
     try:
         CHECKS[kind](result, text)
     except (ValueError, AttributeError, IndexError) as exc:  # the reference cannot read it
-        raise AssertionError(f"{description}: the reader accepted a file the reference rejects ({exc!r})") from None
+        raise AssertionError(
+            f"{description}: the reader accepted a file the reference rejects ({exc!r})"
+        ) from None
     return "read, agrees with the reference"
 
 
@@ -145,7 +157,9 @@ def _mutation_test(kind, source, asf_source=None):
     @given(data=st.data())
     def test(tmp_path, shared, data):
         base = source(shared, tmp_path)
-        read = files.reader_for(kind, tmp_path, asf_source(shared, tmp_path) if asf_source else None)
+        read = files.reader_for(
+            kind, tmp_path, asf_source(shared, tmp_path) if asf_source else None
+        )
         description, mutated = data.draw(mutations(base), label="mutation")
         event(read_mutated(tmp_path, kind, read, description, mutated))
 
@@ -195,7 +209,19 @@ def test_every_line_deleted_or_duplicated(tmp_path, request, name):
     lines = base.split(b"\n")
     outcomes = []
     for i in range(0, len(lines), max(1, len(lines) // 100) if name.startswith("real") else 1):
-        outcomes.append(read_mutated(tmp_path, kind, read, f"delete line {i + 1}", b"\n".join(lines[:i] + lines[i + 1 :])))
-        outcomes.append(read_mutated(tmp_path, kind, read, f"duplicate line {i + 1}", b"\n".join(lines[: i + 1] + lines[i:])))
+        outcomes.append(
+            read_mutated(
+                tmp_path, kind, read, f"delete line {i + 1}", b"\n".join(lines[:i] + lines[i + 1 :])
+            )
+        )
+        outcomes.append(
+            read_mutated(
+                tmp_path,
+                kind,
+                read,
+                f"duplicate line {i + 1}",
+                b"\n".join(lines[: i + 1] + lines[i:]),
+            )
+        )
     assert "MotionFileError" in outcomes
     print(f"{name}: {len(outcomes)} files, {outcomes.count('MotionFileError')} MotionFileErrors")

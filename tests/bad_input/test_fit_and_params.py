@@ -49,21 +49,30 @@ def test_channel_count_different_from_fit(entry):
     extra = [np.c_[np.asarray(c), np.zeros(len(c))] for c in X]
     n = X[0].shape[1]
     for method in output_methods(estimator):
-        with pytest.raises(ValueError, match=f"X has {n + 1} channels, but {entry.name} was fitted with {n} channels"):
+        with pytest.raises(
+            ValueError,
+            match=f"X has {n + 1} channels, but {entry.name} was fitted with {n} channels",
+        ):
             getattr(estimator, method)(extra)
 
 
 # (case id, labels from the good labels, message pattern)
 LABEL_CASES = [
     ("too few labels", lambda y: y[:-1], r"y has \d+ labels,? but X h(as|olds) \d+ clips"),
-    ("too many labels", lambda y: np.r_[y, y[:1]], r"y has \d+ labels,? but X h(as|olds) \d+ clips"),
+    (
+        "too many labels",
+        lambda y: np.r_[y, y[:1]],
+        r"y has \d+ labels,? but X h(as|olds) \d+ clips",
+    ),
     ("2-D labels", lambda y: np.c_[y, y], "y"),
     ("continuous labels", lambda y: np.linspace(0, 1, len(y)), "Unknown label type"),
 ]
 
 
 @pytest.mark.parametrize("entry", CLASSIFIERS, ids=_ids(CLASSIFIERS))
-@pytest.mark.parametrize("case_id, make_bad, fragment", LABEL_CASES, ids=[c[0] for c in LABEL_CASES])
+@pytest.mark.parametrize(
+    "case_id, make_bad, fragment", LABEL_CASES, ids=[c[0] for c in LABEL_CASES]
+)
 def test_bad_labels(entry, case_id, make_bad, fragment):
     X, y = entry.data()
     with pytest.raises(ValueError) as info:
@@ -105,7 +114,11 @@ ONE_FRAME = {
 
 def _finite(result):
     parts = result if isinstance(result, (list, tuple)) else [result]
-    return all(np.isfinite(np.asarray(p, dtype=float)).all() for p in parts if np.asarray(p).dtype.kind in "fiub")
+    return all(
+        np.isfinite(np.asarray(p, dtype=float)).all()
+        for p in parts
+        if np.asarray(p).dtype.kind in "fiub"
+    )
 
 
 @pytest.mark.parametrize("entry", list(ENTRIES.values()), ids=_ids(ENTRIES.values()))
@@ -126,7 +139,9 @@ def test_one_frame_clip(entry):
         return
     estimator = fit(entry, short, y)
     for method in output_methods(estimator):
-        assert _finite(getattr(estimator, method)(short)), f"{method} of a one-frame clip is not finite"
+        assert _finite(getattr(estimator, method)(short)), (
+            f"{method} of a one-frame clip is not finite"
+        )
 
 
 def test_one_frame_clip_resamples_to_a_constant():
@@ -148,10 +163,22 @@ CLIP = np.c_[np.cos(np.linspace(0, 6 * np.pi, 120)), np.sin(np.linspace(0, 6 * n
 
 # (what, call with a frame rate)
 RATE_TAKERS = [
-    ("VirtualMarkerTransform", lambda r: VirtualMarkerTransform(SK, frame_rate=r).fit([np.zeros((3, 66))])),
-    ("ResampleClips(frame_rate)", lambda r: ResampleClips(frame_rate=r, target_frame_rate=10).fit([CLIP])),
-    ("ResampleClips(target_frame_rate)", lambda r: ResampleClips(frame_rate=30, target_frame_rate=r).fit([CLIP])),
-    ("EigenMovementPCA", lambda r: EigenMovementPCA(2, segmentation="zvc", frame_rate=r).fit([CLIP] * 3)),
+    (
+        "VirtualMarkerTransform",
+        lambda r: VirtualMarkerTransform(SK, frame_rate=r).fit([np.zeros((3, 66))]),
+    ),
+    (
+        "ResampleClips(frame_rate)",
+        lambda r: ResampleClips(frame_rate=r, target_frame_rate=10).fit([CLIP]),
+    ),
+    (
+        "ResampleClips(target_frame_rate)",
+        lambda r: ResampleClips(frame_rate=30, target_frame_rate=r).fit([CLIP]),
+    ),
+    (
+        "EigenMovementPCA",
+        lambda r: EigenMovementPCA(2, segmentation="zvc", frame_rate=r).fit([CLIP] * 3),
+    ),
     ("make_motions", lambda r: make_motions(1, frame_rate=r)),
     ("make_repeated_motions", lambda r: make_repeated_motions(frame_rate=r)),
     ("Motion", lambda r: Motion(SK, np.zeros((2, 66)), frame_rate=r)),
@@ -163,7 +190,9 @@ RATE_TAKERS = [
 
 
 @pytest.mark.parametrize("what, call", RATE_TAKERS, ids=[w for w, _ in RATE_TAKERS])
-@pytest.mark.parametrize("rate, error, fragment", BAD_RATES, ids=["zero", "negative", "nan", "inf", "string"])
+@pytest.mark.parametrize(
+    "rate, error, fragment", BAD_RATES, ids=["zero", "negative", "nan", "inf", "string"]
+)
 def test_wrong_frame_rate(what, call, rate, error, fragment):
     with pytest.raises(error) as info:
         call(rate)

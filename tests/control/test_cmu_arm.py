@@ -25,16 +25,22 @@ def test_eigenmovements_of_a_real_right_arm(cmu_punch):
     pca = EigenMovementPCA(10, frame_rate=motion.frame_rate, min_movement=2.0).fit(clips)
     vectors = np.concatenate(pca.segment_vectors(clips))
     codes = pca.transform(clips)
-    rebuilt = np.concatenate([
-        n.transpose(0, 2, 1).reshape(len(n), -1) for n in pca.inverse_transform(codes)
-    ])
-    np.testing.assert_allclose(np.mean(np.sum((vectors - rebuilt) ** 2, axis=1)), pca.projection_mse_, rtol=1e-9)
-    controller = KMeansPrimitiveController(8, random_state=0).fit(codes)
-    quantized = np.concatenate([
-        n.transpose(0, 2, 1).reshape(len(n), -1) for n in pca.inverse_transform(controller.quantize(codes))
-    ])
+    rebuilt = np.concatenate(
+        [n.transpose(0, 2, 1).reshape(len(n), -1) for n in pca.inverse_transform(codes)]
+    )
     np.testing.assert_allclose(
-        np.mean(np.sum((vectors - quantized) ** 2, axis=1)), pca.projection_mse_ + controller.clustering_mse_,
+        np.mean(np.sum((vectors - rebuilt) ** 2, axis=1)), pca.projection_mse_, rtol=1e-9
+    )
+    controller = KMeansPrimitiveController(8, random_state=0).fit(codes)
+    quantized = np.concatenate(
+        [
+            n.transpose(0, 2, 1).reshape(len(n), -1)
+            for n in pca.inverse_transform(controller.quantize(codes))
+        ]
+    )
+    np.testing.assert_allclose(
+        np.mean(np.sum((vectors - quantized) ** 2, axis=1)),
+        pca.projection_mse_ + controller.clustering_mse_,
         rtol=1e-9,
     )
 
@@ -45,7 +51,12 @@ def test_the_arm_of_an_asf_skeleton_follows_its_bone_axes(cmu_punch):
     pytest.importorskip("mujoco")
     skeleton, motion = cmu_punch
     arm = ArmModel.from_skeleton(skeleton, ["rhumerus", "rradius"], dofs=["XYZ", "X"], end="rhand")
-    assert arm.dof_names == ("rhumerus_Zrotation", "rhumerus_Yrotation", "rhumerus_Xrotation", "rradius_Xrotation")
+    assert arm.dof_names == (
+        "rhumerus_Zrotation",
+        "rhumerus_Yrotation",
+        "rhumerus_Xrotation",
+        "rradius_Xrotation",
+    )
     idx = [motion.channel_names.index(n) for n in arm.dof_names]
     target = np.unwrap(motion.channels[600:660, idx], axis=0)
     sim = simulate_arm(target, arm=arm, frame_rate=motion.frame_rate, kp=400.0, kd=40.0)

@@ -18,7 +18,9 @@ def _codes():
     return codes, np.array([0, 1, 2] * 4)
 
 
-@parametrize_with_clip_checks([ClipCase(KMeansPrimitiveController(4, n_init=2, random_state=0), _codes)])
+@parametrize_with_clip_checks(
+    [ClipCase(KMeansPrimitiveController(4, n_init=2, random_state=0), _codes)]
+)
 def test_conformance(check):
     check()
 
@@ -55,7 +57,9 @@ def test_clustering_mse_is_sklearn_inertia_per_segment(arm_model):
     controller = KMeansPrimitiveController(8, random_state=3).fit(codes)
     reference = KMeans(8, n_init=10, random_state=controller.kmeans_.random_state).fit(stacked)
     np.testing.assert_allclose(controller.cluster_centers_, reference.cluster_centers_)
-    np.testing.assert_allclose(controller.clustering_mse_, reference.inertia_ / len(stacked), rtol=1e-6)
+    np.testing.assert_allclose(
+        controller.clustering_mse_, reference.inertia_ / len(stacked), rtol=1e-6
+    )
     assert controller.n_segments_ == len(stacked)
 
 
@@ -65,7 +69,9 @@ def test_predict_is_the_nearest_centre(arm_model):
     labels = controller.predict(codes)
     assert [len(lab) for lab in labels] == [len(c) for c in codes]
     stacked = np.concatenate(codes)
-    brute = np.argmin(((stacked[:, None, :] - controller.cluster_centers_[None]) ** 2).sum(-1), axis=1)
+    brute = np.argmin(
+        ((stacked[:, None, :] - controller.cluster_centers_[None]) ** 2).sum(-1), axis=1
+    )
     np.testing.assert_array_equal(np.concatenate(labels), brute)
     quantized = np.concatenate(controller.quantize(codes))
     np.testing.assert_array_equal(quantized, controller.cluster_centers_[brute])
@@ -75,7 +81,11 @@ def test_transform_is_the_usage_histogram(arm_model):
     _, _, codes = arm_model
     with_empty = [np.empty((0, codes[0].shape[1])), *codes[:5]]
     controller = KMeansPrimitiveController(6, random_state=0).fit(codes)
-    counts = KMeansPrimitiveController(6, random_state=0, normalize=False).fit(codes).transform(with_empty)
+    counts = (
+        KMeansPrimitiveController(6, random_state=0, normalize=False)
+        .fit(codes)
+        .transform(with_empty)
+    )
     usage = controller.transform(with_empty)
     expected = np.array([np.bincount(lab, minlength=6) for lab in controller.predict(with_empty)])
     np.testing.assert_array_equal(counts, expected)

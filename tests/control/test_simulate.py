@@ -12,7 +12,9 @@ G = 9.81
 
 
 def right_arm():
-    return ArmModel.from_skeleton(humanoid_skeleton(), ["RightArm", "RightForeArm"], dofs=["ZXY", "X"], end="RightHand_end")
+    return ArmModel.from_skeleton(
+        humanoid_skeleton(), ["RightArm", "RightForeArm"], dofs=["ZXY", "X"], end="RightHand_end"
+    )
 
 
 def rod(length=0.5, radius=0.04):
@@ -30,7 +32,9 @@ def test_masses_come_from_geometry_and_density():
     arm = right_arm()
     model = mujoco.MjModel.from_xml_string(arm.to_mjcf(kp=1.0, kd=1.0))
     np.testing.assert_allclose(model.body_mass[1:], arm.masses, rtol=1e-9)
-    np.testing.assert_allclose(arm.masses, 1050 * np.pi * np.array([0.045, 0.035]) ** 2 * [0.29, 0.44])
+    np.testing.assert_allclose(
+        arm.masses, 1050 * np.pi * np.array([0.045, 0.035]) ** 2 * [0.29, 0.44]
+    )
 
 
 def test_the_simulated_arm_has_the_skeletons_kinematics():
@@ -50,11 +54,15 @@ def test_without_gains_the_arm_falls_with_the_acceleration_of_a_rigid_rod():
     length, radius = 0.5, 0.04
     alpha = G * (length / 2) / (length**2 / 3 + radius**2 / 4)
     horizontal = np.full((3, 1), np.pi / 2)
-    sim = simulate_arm(horizontal, arm=rod(length, radius), frame_rate=50, kp=0.0, kd=0.0, timestep=1e-4)
+    sim = simulate_arm(
+        horizontal, arm=rod(length, radius), frame_rate=50, kp=0.0, kd=0.0, timestep=1e-4
+    )
     t = sim.times[2]
     np.testing.assert_allclose(np.pi / 2 - sim.angles[2, 0], 0.5 * alpha * t**2, rtol=0.01)
     # And it keeps falling: a second later it has swung through the bottom.
-    later = simulate_arm(np.full((31, 1), np.pi / 2), arm=rod(length, radius), frame_rate=30, kp=0.0, kd=0.0)
+    later = simulate_arm(
+        np.full((31, 1), np.pi / 2), arm=rod(length, radius), frame_rate=30, kp=0.0, kd=0.0
+    )
     assert later.angles[:, 0].min() < 0.0
     assert later.rms_error > 0.5
 
@@ -115,17 +123,32 @@ def test_controller_executes_primitives_on_the_arm():
     codes, segments = pca.transform(clips), pca.segment(clips)
     controller = KMeansPrimitiveController(6, random_state=0).fit(codes)
     sims = controller.simulate(
-        codes[:2], segments[:2], eigenmovements=pca, arm=arm, frame_rate=data.frame_rate,
-        degrees=True, kp=400.0, kd=40.0,
+        codes[:2],
+        segments[:2],
+        eigenmovements=pca,
+        arm=arm,
+        frame_rate=data.frame_rate,
+        degrees=True,
+        kp=400.0,
+        kd=40.0,
     )
-    targets = pca.inverse_transform(controller.quantize(codes[:2]), segments[:2], n_frames=[len(c) for c in clips[:2]])
+    targets = pca.inverse_transform(
+        controller.quantize(codes[:2]), segments[:2], n_frames=[len(c) for c in clips[:2]]
+    )
     for sim, target in zip(sims, targets):
         covered = ~np.isnan(target).any(axis=1)
         np.testing.assert_allclose(sim.desired[covered], np.deg2rad(target[covered]))
         assert np.isnan(sim.angles[~covered]).all() and not np.isnan(sim.angles[covered]).any()
         assert np.degrees(sim.rms_error) < 2.0
-    exact = controller.simulate(codes[:1], segments[:1], eigenmovements=pca, arm=arm,
-                                frame_rate=data.frame_rate, degrees=True, quantize=False)[0]
+    exact = controller.simulate(
+        codes[:1],
+        segments[:1],
+        eigenmovements=pca,
+        arm=arm,
+        frame_rate=data.frame_rate,
+        degrees=True,
+        quantize=False,
+    )[0]
     rebuilt = pca.inverse_transform(codes[:1], segments[:1], n_frames=len(clips[0]))[0]
     covered = ~np.isnan(rebuilt).any(axis=1)
     np.testing.assert_allclose(exact.desired[covered], np.deg2rad(rebuilt[covered]))

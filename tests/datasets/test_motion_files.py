@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from skmotion.datasets import (
+    _fetch,
     fetch_cmu_mocap,
     load_bvh_folder,
     load_cmu_asfamc,
@@ -15,13 +16,12 @@ from skmotion.datasets import (
     make_motions,
     read_cmu_index,
 )
-from skmotion.datasets import _fetch
 from skmotion.io import as_motions, read_amc, read_asf, write_bvh
 from tests.io.test_asf_amc import ASF, _amc, _frames
 
 INDEX = (
     "Subject,Trial #,Motion Description,framerate\n"
-    "5,1,\"walk, then turn\",120\n"
+    '5,1,"walk, then turn",120\n'
     "5,2,jump - high,60\n"
     "6,1,walk,120\n"
 )
@@ -43,7 +43,10 @@ def test_read_cmu_index(tmp_path):
     (tmp_path / "i.csv").write_text(INDEX)
     index = read_cmu_index(tmp_path / "i.csv")
     assert list(index.index) == ["05_01", "05_02", "06_01"]
-    assert index.loc["05_02", "frame_rate"] == 60 and index.loc["05_01", "description"] == "walk, then turn"
+    assert (
+        index.loc["05_02", "frame_rate"] == 60
+        and index.loc["05_01", "description"] == "walk, then turn"
+    )
     (tmp_path / "bad.csv").write_text("a,b\n1,2\n")
     with pytest.raises(ValueError, match="not a CMU index"):
         read_cmu_index(tmp_path / "bad.csv")
@@ -61,19 +64,30 @@ def test_load_cmu_asfamc(tmp_path, rng):
     reference = read_amc(root / "05" / "05_02.amc", read_asf(root / "05" / "05.asf"))
     np.testing.assert_array_equal(data.clips[1], reference.channels)
     only = load_cmu_asfamc(root, subjects=[6])
-    assert only.trials.tolist() == ["06_01"] and only.description.tolist() == [""] and only.frame_rate == 120.0
+    assert (
+        only.trials.tolist() == ["06_01"]
+        and only.description.tolist() == [""]
+        and only.frame_rate == 120.0
+    )
     with pytest.raises(FileNotFoundError, match="No .amc trials"):
         load_cmu_asfamc(root, subjects=[7])
 
 
 def test_load_bvh_folder_labels_by_subfolder(tmp_path):
-    data = make_motions(n_clips_per_class=2, classes=["kick", "wave"], duration=(0.5, 0.6), random_state=0)
+    data = make_motions(
+        n_clips_per_class=2, classes=["kick", "wave"], duration=(0.5, 0.6), random_state=0
+    )
     for k, motion in enumerate(as_motions(data.clips, data.skeletons, data.frame_rate)):
         folder = tmp_path / str(data.target_names[data.target[k]])
         folder.mkdir(exist_ok=True)
         write_bvh(motion, folder / f"take{k}.bvh")
     loaded = load_bvh_folder(tmp_path)
-    assert loaded.target_names.tolist() == ["kick", "wave"] and loaded.target.tolist() == [0, 0, 1, 1]
+    assert loaded.target_names.tolist() == ["kick", "wave"] and loaded.target.tolist() == [
+        0,
+        0,
+        1,
+        1,
+    ]
     for clip, original in zip(loaded.clips, data.clips):
         np.testing.assert_allclose(clip, original, atol=1e-12)
     (tmp_path / "empty").mkdir()
@@ -86,7 +100,9 @@ def test_load_motion_folder_mixes_formats_and_finds_the_index(tmp_path, rng):
     shutil.move(root / "index.csv", tmp_path / "data" / "cmu-index.csv")
     data = make_motions(n_clips_per_class=1, classes=["wave"], duration=(0.5, 0.5), random_state=0)
     (tmp_path / "data" / "waves").mkdir()
-    write_bvh(as_motions(data.clips, data.skeletons, 30.0)[0], tmp_path / "data" / "waves" / "w.bvh")
+    write_bvh(
+        as_motions(data.clips, data.skeletons, 30.0)[0], tmp_path / "data" / "waves" / "w.bvh"
+    )
     loaded = load_motion_folder(tmp_path / "data")
     assert loaded.filenames[0].endswith("w.bvh")
     assert loaded.target_names[loaded.target].tolist() == ["waves", "walk", "jump", "walk"]
@@ -111,7 +127,9 @@ class FakeServer:
 
 
 def test_fetch_downloads_then_reuses_the_cache(tmp_path, rng, monkeypatch):
-    server = FakeServer({"05.asf": ASF, "05_01.amc": _amc(_frames(rng, 3)), "05_02.amc": _amc(_frames(rng, 4))})
+    server = FakeServer(
+        {"05.asf": ASF, "05_01.amc": _amc(_frames(rng, 3)), "05_02.amc": _amc(_frames(rng, 4))}
+    )
     monkeypatch.setattr(_fetch, "_urlopen", server)
     data = fetch_cmu_mocap(5, data_home=tmp_path)
     assert data.trials.tolist() == ["05_01", "05_02"]
@@ -122,7 +140,10 @@ def test_fetch_downloads_then_reuses_the_cache(tmp_path, rng, monkeypatch):
         "http://mocap.cs.cmu.edu/subjects/05/05_03.amc",
     ]
     assert sorted(p.name for p in (tmp_path / "cmu-asfamc" / "05").iterdir() if p.suffix) == [
-        "05.asf", "05_01.amc", "05_02.amc"]
+        "05.asf",
+        "05_01.amc",
+        "05_02.amc",
+    ]
     # Second time: everything from the cache, no request at all.
     server.requests.clear()
     again = fetch_cmu_mocap([5], data_home=tmp_path)
@@ -141,10 +162,15 @@ def test_fetch_uses_local_files_without_network(tmp_path, rng, monkeypatch):
         raise urllib.error.URLError("network is unreachable")
 
     monkeypatch.setattr(_fetch, "_urlopen", offline)
-    data = fetch_cmu_mocap([5], trials=[1, 2], data_home=tmp_path / "home", index=root / "index.csv")
+    data = fetch_cmu_mocap(
+        [5], trials=[1, 2], data_home=tmp_path / "home", index=root / "index.csv"
+    )
     assert data.trials.tolist() == ["05_01", "05_02"] and data.description[1] == "jump - high"
-    with pytest.raises(ConnectionError, match=r"Could not download http://mocap.cs.cmu.edu/subjects/05/05_03.amc "
-                                              r"\(network is unreachable\).*place the files in .*05"):
+    with pytest.raises(
+        ConnectionError,
+        match=r"Could not download http://mocap.cs.cmu.edu/subjects/05/05_03.amc "
+        r"\(network is unreachable\).*place the files in .*05",
+    ):
         fetch_cmu_mocap([5], trials=[3], data_home=tmp_path / "home")
     with pytest.raises(ConnectionError, match="subjects/09/09.asf"):
         fetch_cmu_mocap(9, data_home=tmp_path / "home")

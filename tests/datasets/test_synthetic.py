@@ -55,7 +55,9 @@ def _world(data, i):
 
 def test_feet_stay_on_the_floor_and_jumps_leave_it():
     d = make_motions(n_clips_per_class=4, noise=0.0, random_state=3)
-    feet = [d.skeleton.joint_index(j) for j in ("LeftToe_end", "RightToe_end", "LeftFoot", "RightFoot")]
+    feet = [
+        d.skeleton.joint_index(j) for j in ("LeftToe_end", "RightToe_end", "LeftFoot", "RightFoot")
+    ]
     for i, clip in enumerate(d.clips):
         pos = forward_kinematics(d.skeletons[i], clip).positions
         lowest = pos[:, :, 1].min(axis=1)
@@ -64,7 +66,10 @@ def test_feet_stay_on_the_floor_and_jumps_leave_it():
             assert lowest.max() > (0.1 if name == "jump" else 0.01), name
         else:
             # The sole (ankle height 0.08 below the ankle joint) touches y = 0.
-            sole = np.minimum(pos[:, feet[:2], 1].min(axis=1), pos[:, feet[2:], 1].min(axis=1) - 0.08 * d.subject_scale[d.groups[i]])
+            sole = np.minimum(
+                pos[:, feet[:2], 1].min(axis=1),
+                pos[:, feet[2:], 1].min(axis=1) - 0.08 * d.subject_scale[d.groups[i]],
+            )
             np.testing.assert_allclose(sole, 0.0, atol=1e-9)
         assert lowest.min() > -0.05
 
@@ -111,17 +116,26 @@ def test_not_trivial_for_one_nearest_neighbour(data):
 
 
 def _summary(clips):
-    return np.array([np.r_[c[:, 6:].mean(0), c[:, 6:].std(0), np.abs(np.diff(c[:, 6:], axis=0)).mean(0)] for c in clips])
+    return np.array(
+        [
+            np.r_[c[:, 6:].mean(0), c[:, 6:].std(0), np.abs(np.diff(c[:, 6:], axis=0)).mean(0)]
+            for c in clips
+        ]
+    )
 
 
 def test_classes_are_distinguishable_across_subjects(data):
     model = make_pipeline(StandardScaler(), LogisticRegression(max_iter=3000))
-    accuracy = cross_val_score(model, _summary(data.clips), data.target, groups=data.groups, cv=GroupKFold(4)).mean()
+    accuracy = cross_val_score(
+        model, _summary(data.clips), data.target, groups=data.groups, cv=GroupKFold(4)
+    ).mean()
     assert accuracy > 0.85
 
 
 def test_return_X_y():
-    X, y = make_motions(n_clips_per_class=2, classes=["wave", "squat"], return_X_y=True, random_state=0)
+    X, y = make_motions(
+        n_clips_per_class=2, classes=["wave", "squat"], return_X_y=True, random_state=0
+    )
     assert len(X) == 4 and y.tolist() == [0, 0, 1, 1]
 
 

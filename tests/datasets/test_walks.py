@@ -10,7 +10,10 @@ def test_root_velocity_is_the_clips_own():
     data = make_walks(1, turn=0.5, random_state=3)
     sk = data.skeleton
     for clip, truth in zip(data.clips, data.root_velocity):
-        x, z = clip[:, sk.channel_index("Hips", "Xposition")], clip[:, sk.channel_index("Hips", "Zposition")]
+        x, z = (
+            clip[:, sk.channel_index("Hips", "Xposition")],
+            clip[:, sk.channel_index("Hips", "Zposition")],
+        )
         yaw = clip[:, sk.channel_index("Hips", "Yrotation")]
         vx, vz = np.diff(x) * data.frame_rate, np.diff(z) * data.frame_rate
         # Facing (sin yaw, cos yaw) and left (cos yaw, -sin yaw) in the world's (X, Z).
@@ -22,7 +25,10 @@ def test_root_velocity_is_the_clips_own():
 
 
 def test_directions_and_seed():
-    a, b = make_walks(1, directions=["backward"], random_state=0), make_walks(1, directions=["backward"], random_state=0)
+    a, b = (
+        make_walks(1, directions=["backward"], random_state=0),
+        make_walks(1, directions=["backward"], random_state=0),
+    )
     np.testing.assert_array_equal(a.clips[0], b.clips[0])
     assert a.root_velocity[0][:, 0].max() < 0
     with pytest.raises(ValueError, match="directions"):

@@ -14,7 +14,9 @@ def test_matches_the_svd_of_every_clip(seed, n_channels, n_vectors):
     # Lengths on both sides of n_channels, repeated so that clips share a batch,
     # and one rank-deficient clip (a repeated frame pattern).
     lengths = rng.integers(1, 2 * n_channels + 2, size=12)
-    clips = [rng.normal(size=(n, n_channels)) * rng.uniform(0.5, 3.0, size=n_channels) for n in lengths]
+    clips = [
+        rng.normal(size=(n, n_channels)) * rng.uniform(0.5, 3.0, size=n_channels) for n in lengths
+    ]
     clips.append(np.tile(rng.normal(size=(1, n_channels)), (5, 1)))
     n_vectors = min(n_vectors, n_channels)
     eigenvalues, vectors = clip_spectra(clips, n_vectors)

@@ -23,7 +23,9 @@ def stroke_clips(n_clips=12, seed=0):
         for k in range(4):
             n = int(rng.integers(18, 30))
             parts.append(parts[-1][-1] + (poses[k + 1] - parts[-1][-1]) * minimum_jerk(n)[:, None])
-        clips.append(np.concatenate(parts) + 0.002 * rng.normal(size=(1 + sum(len(p) for p in parts[1:]), 3)))
+        clips.append(
+            np.concatenate(parts) + 0.002 * rng.normal(size=(1 + sum(len(p) for p in parts[1:]), 3))
+        )
     return clips
 
 
@@ -85,9 +87,13 @@ def test_components_match_sklearn_pca(arm_degrees):
     pca = EigenMovementPCA(6).fit(arm_degrees)
     vectors = np.concatenate(pca.segment_vectors(arm_degrees))
     reference = PCA(6, svd_solver="full").fit(vectors)
-    np.testing.assert_allclose(np.abs(pca.components_ @ reference.components_.T), np.eye(6), atol=1e-6)
+    np.testing.assert_allclose(
+        np.abs(pca.components_ @ reference.components_.T), np.eye(6), atol=1e-6
+    )
     n = len(vectors)
-    np.testing.assert_allclose(pca.explained_variance_, reference.explained_variance_ * (n - 1) / n, rtol=1e-8)
+    np.testing.assert_allclose(
+        pca.explained_variance_, reference.explained_variance_ * (n - 1) / n, rtol=1e-8
+    )
     np.testing.assert_allclose(pca.mean_, reference.mean_)
     # Deterministic signs: the largest entry of each eigenmovement is positive.
     rows = np.arange(6)
@@ -143,7 +149,9 @@ def test_inverse_transform_retimes_and_places_segments():
             np.testing.assert_allclose(back[inside], expected[1:-1], atol=1e-12)
         assert np.isnan(back[~covered]).all() and not np.isnan(back[covered]).any()
     # by default the clip ends at the last segment's stop
-    assert [len(b) for b in pca.inverse_transform(codes, segments)] == [int(s[-1, 1]) for s in segments]
+    assert [len(b) for b in pca.inverse_transform(codes, segments)] == [
+        int(s[-1, 1]) for s in segments
+    ]
 
 
 def test_a_shared_boundary_frame_is_the_mean_of_its_two_segments():
@@ -182,12 +190,15 @@ def test_pickle_round_trip_gives_identical_codes(arm_degrees):
         np.testing.assert_array_equal(a, b)
 
 
-@pytest.mark.parametrize("params, match", [
-    ({"segmentation": "zvc"}, "segmentation='zvc' needs frame_rate"),
-    ({"energy_threshold": 1.0}, "explicit energy_threshold needs frame_rate"),
-    ({"n_components": 500}, r"n_components=500 must be at most min\(n_segments, n_features\)"),
-    ({"min_movement": 1e9}, "No segments were found in the 9 training clips"),
-])
+@pytest.mark.parametrize(
+    "params, match",
+    [
+        ({"segmentation": "zvc"}, "segmentation='zvc' needs frame_rate"),
+        ({"energy_threshold": 1.0}, "explicit energy_threshold needs frame_rate"),
+        ({"n_components": 500}, r"n_components=500 must be at most min\(n_segments, n_features\)"),
+        ({"min_movement": 1e9}, "No segments were found in the 9 training clips"),
+    ],
+)
 def test_fit_errors(params, match):
     with pytest.raises(ValueError, match=match):
         EigenMovementPCA(**params).fit(stroke_clips(9))
@@ -217,7 +228,9 @@ def test_clips_without_segments_give_empty_codes():
     pca = EigenMovementPCA(3).fit(clips)
     codes = pca.transform([still, clips[0]])
     assert codes[0].shape == (0, 3) and len(codes[1]) > 0
-    rebuilt = pca.inverse_transform(codes, pca.segment([still, clips[0]]), n_frames=[60, len(clips[0])])
+    rebuilt = pca.inverse_transform(
+        codes, pca.segment([still, clips[0]]), n_frames=[60, len(clips[0])]
+    )
     assert np.isnan(rebuilt[0]).all()
     with pytest.raises(ValueError, match="No segments were found in the 1 clips"):
         pca.score([still])

@@ -12,7 +12,9 @@ from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 
 
 def _data():
-    data = make_motions(n_clips_per_class=3, classes=["walk", "wave", "squat"], duration=(1.0, 1.5), random_state=0)
+    data = make_motions(
+        n_clips_per_class=3, classes=["walk", "wave", "squat"], duration=(1.0, 1.5), random_state=0
+    )
     return [c[:, 6:] for c in data.clips], data.target
 
 
@@ -67,7 +69,9 @@ def test_matches_svd_reference(weighting):
     others = [rng.normal(size=(n, clips[0].shape[1])) for n in (5, 30, 90)]
     extractor = SVDFeatureExtractor(n_components=5, weighting=weighting).fit(clips)
     np.testing.assert_allclose(
-        extractor.transform(clips + others), reference_features(clips, clips + others, 5, weighting), atol=1e-8
+        extractor.transform(clips + others),
+        reference_features(clips, clips + others, 5, weighting),
+        atol=1e-8,
     )
 
 
@@ -85,7 +89,9 @@ def _spectra(clips):
     return clip_spectra(clips, 2)
 
 
-clip_strategy = arrays(np.float64, st.tuples(st.integers(8, 30), st.just(4)), elements=st.floats(-3, 3, width=32))
+clip_strategy = arrays(
+    np.float64, st.tuples(st.integers(8, 30), st.just(4)), elements=st.floats(-3, 3, width=32)
+)
 
 
 @given(clip_strategy, st.integers(2, 4), st.randoms(use_true_random=False))
@@ -93,7 +99,10 @@ def test_repeating_or_reordering_frames_keeps_the_features(clip, times, random):
     rng = np.random.default_rng(0)
     train = [rng.normal(size=(20, 4)) * [4, 3, 2, 1] + 1 for _ in range(6)]
     extractor = SVDFeatureExtractor(n_components=3, weighting="first_two").fit(train)
-    if np.linalg.svd(clip, compute_uv=False)[:3].min() < 1e-3 or np.abs(np.diff(np.linalg.svd(clip, compute_uv=False)[:3])).min() < 1e-3:
+    if (
+        np.linalg.svd(clip, compute_uv=False)[:3].min() < 1e-3
+        or np.abs(np.diff(np.linalg.svd(clip, compute_uv=False)[:3])).min() < 1e-3
+    ):
         return  # repeated or vanishing singular values: the vectors are not unique
     order = list(range(len(clip)))
     random.shuffle(order)
@@ -128,4 +137,8 @@ def test_errors_name_the_problem():
 def test_feature_names():
     clips, _ = _data()
     names = SVDFeatureExtractor(n_components=3).fit(clips).get_feature_names_out()
-    assert names.tolist() == ["svdfeatureextractor0", "svdfeatureextractor1", "svdfeatureextractor2"]
+    assert names.tolist() == [
+        "svdfeatureextractor0",
+        "svdfeatureextractor1",
+        "svdfeatureextractor2",
+    ]

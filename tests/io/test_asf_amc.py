@@ -5,7 +5,15 @@ import re
 import numpy as np
 import pytest
 
-from skmotion.io import Motion, MotionFileError, acclaim_order, read_amc, read_asf, read_bvh, write_bvh
+from skmotion.io import (
+    Motion,
+    MotionFileError,
+    acclaim_order,
+    read_amc,
+    read_asf,
+    read_bvh,
+    write_bvh,
+)
 from skmotion.preprocessing import VirtualMarkerTransform
 
 ASF = """# a small Acclaim skeleton with tilted bone axes and dof subsets
@@ -72,10 +80,13 @@ ASF = """# a small Acclaim skeleton with tilted bone axes and dof subsets
 def _amc(frames):
     lines = [":FULLY-SPECIFIED", ":DEGREES"]
     for k, f in enumerate(frames, start=1):
-        lines += [str(k), "root " + " ".join(f"{v:.6f}" for v in f[:6]),
-                  "femur " + " ".join(f"{v:.6f}" for v in f[6:9]),
-                  "tibia " + " ".join(f"{v:.6f}" for v in f[9:11]),
-                  "back " + f"{f[11]:.6f}"]
+        lines += [
+            str(k),
+            "root " + " ".join(f"{v:.6f}" for v in f[:6]),
+            "femur " + " ".join(f"{v:.6f}" for v in f[6:9]),
+            "tibia " + " ".join(f"{v:.6f}" for v in f[9:11]),
+            "back " + f"{f[11]:.6f}",
+        ]
     return "\r\n".join(lines) + "\r\n"
 
 
@@ -108,7 +119,9 @@ def _rot(axis, degrees):
 def _parse_asf_for_reference(text):
     bones = {}
     for block in re.findall(r"begin(.*?)end", text.split(":hierarchy")[0], flags=re.S):
-        fields = {line.split()[0]: line.split()[1:] for line in block.strip().splitlines() if line.split()}
+        fields = {
+            line.split()[0]: line.split()[1:] for line in block.strip().splitlines() if line.split()
+        }
         bones[fields["name"][0]] = {
             "direction": np.array(fields["direction"], dtype=float),
             "length": float(fields["length"][0]),
@@ -143,7 +156,9 @@ def acclaim_positions(asf_text, amc_text):
     result = []
     for frame in _parse_amc_for_reference(amc_text):
         tx, ty, tz, rx, ry, rz = frame["root"]
-        root_rotation = _rot("z", rz) @ _rot("y", ry) @ _rot("x", rx)  # axis XYZ: x first, fixed axes
+        root_rotation = (
+            _rot("z", rz) @ _rot("y", ry) @ _rot("x", rx)
+        )  # axis XYZ: x first, fixed axes
         out = {}
 
         def visit(name, start, parent_rotation):
@@ -154,7 +169,9 @@ def acclaim_positions(asf_text, amc_text):
             for dof, value in zip(bone["dof"], frame.get(name, [])):
                 m = _rot(dof[1], value) @ m  # each dof applied after the previous, about fixed axes
             rotation = parent_rotation @ c @ m @ c.T
-            end = start + rotation @ (bone["length"] * bone["direction"] / np.linalg.norm(bone["direction"]))
+            end = start + rotation @ (
+                bone["length"] * bone["direction"] / np.linalg.norm(bone["direction"])
+            )
             out[name] = (start, end)
             for child in children.get(name, []):
                 visit(child, end, rotation)
@@ -175,7 +192,9 @@ def _assert_matches_reference(motion, asf_text, amc_text):
             np.testing.assert_allclose(positions[f, sk.joint_index(name)], start, atol=1e-9)
             tip = [c for c in sk.children(name)] or []
             if f"{name}_end" in sk.joints:
-                np.testing.assert_allclose(positions[f, sk.joint_index(f"{name}_end")], end, atol=1e-9)
+                np.testing.assert_allclose(
+                    positions[f, sk.joint_index(f"{name}_end")], end, atol=1e-9
+                )
             for child in tip:
                 np.testing.assert_allclose(positions[f, child], end, atol=1e-9)
 
@@ -190,7 +209,14 @@ def test_toy_skeleton_structure_and_units(toy):
     asf, amc, _ = toy
     sk = read_asf(asf)
     assert sk.joints == ("root", "hipjoint", "femur", "tibia", "tibia_end", "back", "back_end")
-    assert sk.channels[0] == ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
+    assert sk.channels[0] == (
+        "Xposition",
+        "Yposition",
+        "Zposition",
+        "Xrotation",
+        "Yrotation",
+        "Zrotation",
+    )
     assert sk.channels[1] == () and sk.channels[3] == ("Xrotation", "Zrotation")
     assert sk.rotation_orders[2] == "ZYX" and sk.rotation_orders[3] == "ZXY"
     assert sk.meters_per_unit == pytest.approx(0.0254 / 0.45) and sk.up_axis == "y"
@@ -213,7 +239,9 @@ def test_bones_in_any_order_within_a_frame(toy, tmp_path):
     swapped = lines[:3] + [lines[5], lines[3], lines[6], lines[4]] + lines[7:]
     (tmp_path / "swapped.amc").write_text("\n".join(swapped) + "\n")
     sk = read_asf(asf)
-    np.testing.assert_array_equal(read_amc(tmp_path / "swapped.amc", sk).channels, read_amc(amc, sk).channels)
+    np.testing.assert_array_equal(
+        read_amc(tmp_path / "swapped.amc", sk).channels, read_amc(amc, sk).channels
+    )
 
 
 def test_radians_header(toy, tmp_path):
@@ -244,18 +272,38 @@ def _replace(text, old, new):
 
 AMC_ERRORS = [
     ("unknown bone", lambda t: _replace(t, "tibia ", "fibula "), r"line 6: unknown bone 'fibula'"),
-    ("value count", lambda t: re.sub(r"(\nback \S+)", r"\1 1.0", t, count=1),
-     r"line 7: bone 'back' has 2 values, but its dof has 1"),
-    ("truncated", lambda t: t.rsplit("\n", 3)[0] + "\n", r"frame 6 lacks bone 'tibia' \(truncated file\?\)"),
-    ("non-numeric", lambda t: re.sub(r"(\nfemur )\S+", r"\1abc", t, count=1), r"line 5: non-numeric value 'abc'"),
+    (
+        "value count",
+        lambda t: re.sub(r"(\nback \S+)", r"\1 1.0", t, count=1),
+        r"line 7: bone 'back' has 2 values, but its dof has 1",
+    ),
+    (
+        "truncated",
+        lambda t: t.rsplit("\n", 3)[0] + "\n",
+        r"frame 6 lacks bone 'tibia' \(truncated file\?\)",
+    ),
+    (
+        "non-numeric",
+        lambda t: re.sub(r"(\nfemur )\S+", r"\1abc", t, count=1),
+        r"line 5: non-numeric value 'abc'",
+    ),
     ("frame numbers", lambda t: _replace(t, "\n2\n", "\n3\n"), r"line 8: frame number 3 follows 1"),
-    ("bone before frame", lambda t: _replace(t, ":DEGREES\n1\n", ":DEGREES\nroot 0 0 0 0 0 0\n1\n"),
-     r"line 3: bone data before the first frame number"),
-    ("twice", lambda t: _replace(t, "\n2\n", "\nback 1.0\n2\n"), r"line 3: frame 1 lists twice bone 'back'"),
+    (
+        "bone before frame",
+        lambda t: _replace(t, ":DEGREES\n1\n", ":DEGREES\nroot 0 0 0 0 0 0\n1\n"),
+        r"line 3: bone data before the first frame number",
+    ),
+    (
+        "twice",
+        lambda t: _replace(t, "\n2\n", "\nback 1.0\n2\n"),
+        r"line 3: frame 1 lists twice bone 'back'",
+    ),
 ]
 
 
-@pytest.mark.parametrize("edit, message", [e[1:] for e in AMC_ERRORS], ids=[e[0] for e in AMC_ERRORS])
+@pytest.mark.parametrize(
+    "edit, message", [e[1:] for e in AMC_ERRORS], ids=[e[0] for e in AMC_ERRORS]
+)
 def test_malformed_amc_names_file_and_line(toy, tmp_path, edit, message):
     asf, amc, _ = toy
     path = tmp_path / "broken.amc"
@@ -265,17 +313,30 @@ def test_malformed_amc_names_file_and_line(toy, tmp_path, edit, message):
 
 
 ASF_ERRORS = [
-    ("missing end", lambda t: _replace(t, "    dof ry\n    limits (-20.0 45.0)\n  end\n", "    dof ry\n"),
-     r"line 5[0-9]: the bone opened at line 4[0-9] has no 'end'"),
-    ("unknown bone", lambda t: _replace(t, "femur tibia", "femur fibula"), r"line \d+: unknown bone 'fibula'"),
-    ("non-numeric", lambda t: _replace(t, "length 7.3", "length seven"), r"line 3[0-9]: non-numeric value 'seven'"),
+    (
+        "missing end",
+        lambda t: _replace(t, "    dof ry\n    limits (-20.0 45.0)\n  end\n", "    dof ry\n"),
+        r"line 5[0-9]: the bone opened at line 4[0-9] has no 'end'",
+    ),
+    (
+        "unknown bone",
+        lambda t: _replace(t, "femur tibia", "femur fibula"),
+        r"line \d+: unknown bone 'fibula'",
+    ),
+    (
+        "non-numeric",
+        lambda t: _replace(t, "length 7.3", "length seven"),
+        r"line 3[0-9]: non-numeric value 'seven'",
+    ),
     ("bad dof", lambda t: _replace(t, "dof ry", "dof ry l"), r"dof 'l' is not supported"),
     ("hierarchy end", lambda t: t.rsplit("end", 1)[0], r"file ends where 'end' of the hierarchy"),
     ("no root", lambda t: t.replace(":root", ":rooted"), r"no :root section"),
 ]
 
 
-@pytest.mark.parametrize("edit, message", [e[1:] for e in ASF_ERRORS], ids=[e[0] for e in ASF_ERRORS])
+@pytest.mark.parametrize(
+    "edit, message", [e[1:] for e in ASF_ERRORS], ids=[e[0] for e in ASF_ERRORS]
+)
 def test_malformed_asf_names_file_and_line(tmp_path, edit, message):
     path = tmp_path / "broken.asf"
     path.write_text(edit(ASF))

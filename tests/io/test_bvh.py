@@ -79,9 +79,11 @@ def test_every_rotation_order_matches_scipy(tmp_path, order):
     angles = [23.0, -41.0, 67.0]
     channels = " ".join(f"{a}rotation" for a in order)
     text = (
-        "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 3 " + channels
+        "HIERARCHY\nROOT a\n{\n OFFSET 0 0 0\n CHANNELS 3 "
+        + channels
         + "\n End Site\n {\n  OFFSET 0 1 0\n }\n}\nMOTION\nFrames: 1\nFrame Time: 0.1\n"
-        + " ".join(map(str, angles)) + "\n"
+        + " ".join(map(str, angles))
+        + "\n"
     )
     motion = read_bvh(write(tmp_path, text), up_axis="y")
     rotation = motion.forward_kinematics().rotations[0, 0]
@@ -93,8 +95,13 @@ def test_up_axis_detection_and_override(tmp_path):
     z_up = LEG.replace("OFFSET 0 -40 0", "OFFSET 0 0 -40").replace(
         "0 90 0 0 0 0 0 0 0 1 2 3 0 0 0", "0 0 90 0 0 0 0 0 0 1 2 3 0 0 0"
     )
-    path = write(tmp_path, z_up.replace("10 90 0 90 0 0 0 90 0 1 2 3 0 0 0\n10 90 5 0 0 0 0 0 0 0 0 -10 0 45 0\n",
-                                        "0 0 90 0 0 0 0 0 0 1 2 3 0 0 0\n0 0 90 0 0 0 0 0 0 1 2 3 0 0 0\n"))
+    path = write(
+        tmp_path,
+        z_up.replace(
+            "10 90 0 90 0 0 0 90 0 1 2 3 0 0 0\n10 90 5 0 0 0 0 0 0 0 0 -10 0 45 0\n",
+            "0 0 90 0 0 0 0 0 0 1 2 3 0 0 0\n0 0 90 0 0 0 0 0 0 1 2 3 0 0 0\n",
+        ),
+    )
     assert read_bvh(path).skeleton.up_axis == "z"
     assert read_bvh(path, up_axis="x").skeleton.up_axis == "x"
     with pytest.raises(ValueError, match="up_axis"):
@@ -107,7 +114,9 @@ def test_frame_rate_is_kept_when_not_a_whole_number(tmp_path):
 
 
 def _make_motion(random_state=0):
-    data = make_motions(n_clips_per_class=1, classes=["kick"], duration=(1.0, 1.0), random_state=random_state)
+    data = make_motions(
+        n_clips_per_class=1, classes=["kick"], duration=(1.0, 1.0), random_state=random_state
+    )
     return Motion(data.skeletons[0], data.clips[0], frame_rate=data.frame_rate)
 
 
@@ -130,9 +139,13 @@ def test_round_trip_with_few_decimals_is_close(tmp_path):
     back = read_bvh(tmp_path / "kick.bvh")
     rotations = np.array([c.endswith("rotation") for c in motion.channel_names])
     np.testing.assert_allclose(
-        np.rad2deg(back.channels[:, rotations]), np.rad2deg(motion.channels[:, rotations]), atol=0.5e-4 + 1e-12
+        np.rad2deg(back.channels[:, rotations]),
+        np.rad2deg(motion.channels[:, rotations]),
+        atol=0.5e-4 + 1e-12,
     )
-    np.testing.assert_allclose(back.channels[:, ~rotations], motion.channels[:, ~rotations], atol=0.5e-4 + 1e-12)
+    np.testing.assert_allclose(
+        back.channels[:, ~rotations], motion.channels[:, ~rotations], atol=0.5e-4 + 1e-12
+    )
     with pytest.raises(ValueError, match="precision"):
         write_bvh(motion, tmp_path / "x.bvh", precision=-1)
     with pytest.raises(TypeError, match="Motion"):
@@ -145,7 +158,9 @@ def skeletons_and_channels(draw):
     n = draw(st.integers(1, 7))
     parents = [-1] + [draw(st.integers(0, j - 1)) for j in range(1, n)]
     kinds = ["Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation"]
-    channels = [draw(st.permutations(kinds))[: draw(st.sampled_from([0, 1, 2, 3, 6]))] for _ in range(n)]
+    channels = [
+        draw(st.permutations(kinds))[: draw(st.sampled_from([0, 1, 2, 3, 6]))] for _ in range(n)
+    ]
     offsets = draw(st.lists(st.tuples(*[st.floats(-50, 50)] * 3), min_size=n, max_size=n))
     skeleton = Skeleton([f"j{j}" for j in range(n)], parents, offsets, channels)
     rng = np.random.default_rng(draw(st.integers(0, 2**16)))
@@ -171,7 +186,9 @@ def test_round_trip_property(tmp_path_factory, case):
     order = _depth_first(skeleton)
     assert len(back.skeleton.joints) == len(order)
     np.testing.assert_allclose(
-        back.forward_kinematics().positions, motion.forward_kinematics().positions[:, order], atol=1e-9
+        back.forward_kinematics().positions,
+        motion.forward_kinematics().positions[:, order],
+        atol=1e-9,
     )
     np.testing.assert_array_equal(back.skeleton.offsets, np.asarray(skeleton.offsets)[order])
 
@@ -186,18 +203,50 @@ def _broken(text, old, new):
 
 MALFORMED = [
     ("truncated", LEG.rsplit("\n", 2)[0] + "\n", r"line 25: the MOTION block ends after 2 frames"),
-    ("value count", _broken(LEG, "10 90 5 0 0 0 0 0 0 0 0 -10 0 45 0", "10 90 5 0 0 0 0 0 0 0 0 -10 0 45"),
-     r"line 26: 14 values on a frame line, but the hierarchy has 15 channels"),
-    ("non-numeric", _broken(LEG, "10 90 0 90", "10 ninety 0 90"), r"line 25: non-numeric value 'ninety'"),
-    ("missing brace", _broken(LEG, "\t\t\tOFFSET 0 -40 0\n\t\t}", "\t\t\tOFFSET 0 -40 0\n"),
-     r"line 20: file ends where '}' closing joint 'hip' \(opened at line 3\)"),
-    ("missing joint brace", _broken(LEG, "\t\t}\n\t}\n\tJOINT tail", "\t\t}\n\tJOINT tail").rsplit("}\nMOTION", 1)[0]
-     + "MOTION" + LEG.split("MOTION")[1], r"line 18: file ends where '}' closing joint 'knee' \(opened at line 7\)"),
-    ("unknown channel", _broken(LEG, "Zrotation Xrotation Yrotation\n\t\tEnd", "Zrotation Qrotation Yrotation\n\t\tEnd"),
-     r"line 9: unknown channel 'Qrotation'"),
-    ("non-numeric offset", _broken(LEG, "OFFSET 0 0 -10", "OFFSET 0 zero -10"), r"line 17: non-numeric value 'zero' in OFFSET of 'tail'"),
-    ("too many frames", _broken(LEG, "Frames: 3", "Frames: 2"), r"line 26: more frame lines than the 2 declared"),
-    ("bad frame count", _broken(LEG, "Frames: 3", "Frames: three"), r"line 22: Frames must be an integer"),
+    (
+        "value count",
+        _broken(LEG, "10 90 5 0 0 0 0 0 0 0 0 -10 0 45 0", "10 90 5 0 0 0 0 0 0 0 0 -10 0 45"),
+        r"line 26: 14 values on a frame line, but the hierarchy has 15 channels",
+    ),
+    (
+        "non-numeric",
+        _broken(LEG, "10 90 0 90", "10 ninety 0 90"),
+        r"line 25: non-numeric value 'ninety'",
+    ),
+    (
+        "missing brace",
+        _broken(LEG, "\t\t\tOFFSET 0 -40 0\n\t\t}", "\t\t\tOFFSET 0 -40 0\n"),
+        r"line 20: file ends where '}' closing joint 'hip' \(opened at line 3\)",
+    ),
+    (
+        "missing joint brace",
+        _broken(LEG, "\t\t}\n\t}\n\tJOINT tail", "\t\t}\n\tJOINT tail").rsplit("}\nMOTION", 1)[0]
+        + "MOTION"
+        + LEG.split("MOTION")[1],
+        r"line 18: file ends where '}' closing joint 'knee' \(opened at line 7\)",
+    ),
+    (
+        "unknown channel",
+        _broken(
+            LEG, "Zrotation Xrotation Yrotation\n\t\tEnd", "Zrotation Qrotation Yrotation\n\t\tEnd"
+        ),
+        r"line 9: unknown channel 'Qrotation'",
+    ),
+    (
+        "non-numeric offset",
+        _broken(LEG, "OFFSET 0 0 -10", "OFFSET 0 zero -10"),
+        r"line 17: non-numeric value 'zero' in OFFSET of 'tail'",
+    ),
+    (
+        "too many frames",
+        _broken(LEG, "Frames: 3", "Frames: 2"),
+        r"line 26: more frame lines than the 2 declared",
+    ),
+    (
+        "bad frame count",
+        _broken(LEG, "Frames: 3", "Frames: three"),
+        r"line 22: Frames must be an integer",
+    ),
     ("no motion", LEG.split("MOTION")[0], r"no MOTION block"),
     ("not hierarchy", "HELLO\n" + LEG, r"line 1: expected 'HIERARCHY'"),
 ]
@@ -216,7 +265,9 @@ def test_written_file_is_read_alike_by_a_peer_reader(tmp_path):
     write_bvh(motion, tmp_path / "kick.bvh", precision=6)
     peer = bvh.Bvh((tmp_path / "kick.bvh").read_text())
     assert peer.nframes == motion.n_frames
-    assert list(peer.get_joints_names()) == [j for j in motion.skeleton.joints if not j.endswith("_end")]
+    assert list(peer.get_joints_names()) == [
+        j for j in motion.skeleton.joints if not j.endswith("_end")
+    ]
     rotations = np.array([c.endswith("rotation") for c in motion.channel_names])
     expected = np.where(rotations, np.rad2deg(motion.channels), motion.channels)
     np.testing.assert_allclose(np.asarray(peer.frames, dtype=float), expected, atol=1e-6)
@@ -237,4 +288,6 @@ def test_reads_every_bvh_file_of_the_shared_data(shared_data, tmp_path):
         assert np.isfinite(motion.channels).all()
     sample = read_bvh(files[0])
     write_bvh(sample, tmp_path / "again.bvh")
-    np.testing.assert_allclose(read_bvh(tmp_path / "again.bvh").channels, sample.channels, atol=1e-12)
+    np.testing.assert_allclose(
+        read_bvh(tmp_path / "again.bvh").channels, sample.channels, atol=1e-12
+    )

@@ -20,7 +20,9 @@ def test_motion_is_a_clip(skeleton, rng):
     restored = pickle.loads(pickle.dumps(motion))
     np.testing.assert_array_equal(restored.channels, channels)
     assert restored.skeleton == skeleton and restored.source == "x.bvh"
-    np.testing.assert_allclose(motion.forward_kinematics().positions, skeleton.forward_kinematics(channels).positions)
+    np.testing.assert_allclose(
+        motion.forward_kinematics().positions, skeleton.forward_kinematics(channels).positions
+    )
 
 
 def test_motion_validates(skeleton):

@@ -14,7 +14,10 @@ def _write(tmp_path, body, header=HEADER, name="toy.ts"):
 
 
 def test_unequal_lengths_missing_values_and_labels(tmp_path):
-    path = _write(tmp_path, "@equalLength false\n@classLabel true walk run\n@data\n1,2,3:4,?,6:walk\n\n7,8:9,1e-3:run\n")
+    path = _write(
+        tmp_path,
+        "@equalLength false\n@classLabel true walk run\n@data\n1,2,3:4,?,6:walk\n\n7,8:9,1e-3:run\n",
+    )
     clips, labels = read_ts(path)
     np.testing.assert_array_equal(clips[0], [[1, 4], [2, np.nan], [3, 6]])
     np.testing.assert_array_equal(clips[1], [[7, 9], [8, 0.001]])
@@ -22,7 +25,9 @@ def test_unequal_lengths_missing_values_and_labels(tmp_path):
 
 
 def test_equal_length_without_labels(tmp_path):
-    path = _write(tmp_path, "@equalLength true\n@seriesLength 2\n@classLabel false\n@data\n1,2:3,4\n5,6:7,8\n")
+    path = _write(
+        tmp_path, "@equalLength true\n@seriesLength 2\n@classLabel false\n@data\n1,2:3,4\n5,6:7,8\n"
+    )
     clips, labels = read_ts(path)
     assert labels is None
     np.testing.assert_array_equal(np.stack(clips), [[[1, 3], [2, 4]], [[5, 7], [6, 8]]])
@@ -33,10 +38,18 @@ def test_equal_length_without_labels(tmp_path):
     [
         ("@classLabel true a b\n1,2:3,4:a\n", 8, "data before the @data tag"),
         ("@classLabel true a b\n@data\n1,2:3,4:c\n", 9, "label 'c' is not declared"),
-        ("@classLabel true a b\n@data\n1,2:3,4:a\n1,2:a\n", 10, "1 dimensions, but the file declares 2"),
+        (
+            "@classLabel true a b\n@data\n1,2:3,4:a\n1,2:a\n",
+            10,
+            "1 dimensions, but the file declares 2",
+        ),
         ("@classLabel true a b\n@data\n1,2:3:a\n", 9, r"differ in length: \[2, 1\]"),
         ("@classLabel true a b\n@data\n1,x:3,4:a\n", 9, "dimension 1: non-numeric value 'x'"),
-        ("@equalLength true\n@seriesLength 3\n@classLabel true a\n@data\n1,2:3,4:a\n", 11, "@seriesLength is 3"),
+        (
+            "@equalLength true\n@seriesLength 3\n@classLabel true a\n@data\n1,2:3,4:a\n",
+            11,
+            "@seriesLength is 3",
+        ),
         ("@classLabel maybe a\n@data\n", 7, "must start with true or false"),
         ("@dimensions two\n@data\n", 7, "must be an integer"),
     ],
@@ -50,8 +63,11 @@ def test_malformed_files_name_file_and_line(tmp_path, body, line, message):
 
 @pytest.mark.parametrize(
     "body, message",
-    [("@classLabel true a\n", "no @data tag"), ("@classLabel true a\n@data\n", "no series"),
-     ("@timeStamps true\n@data\n(0,1),(1,2):a\n", "timestamped")],
+    [
+        ("@classLabel true a\n", "no @data tag"),
+        ("@classLabel true a\n@data\n", "no series"),
+        ("@timeStamps true\n@data\n(0,1),(1,2):a\n", "timestamped"),
+    ],
 )
 def test_structurally_empty_or_unsupported(tmp_path, body, message):
     with pytest.raises(MotionFileError, match=message):

@@ -81,7 +81,9 @@ def test_root_turned_90_degrees_about_vertical():
     )
     fk = forward_kinematics(sk, [[2.0, 1.0, -3.0, 90 * DEG]])
     # Ry(90) takes +Z to +X: the nose now points along +X.
-    np.testing.assert_allclose(fk.positions[0], [[2, 1, -3], [2, 1.7, -3], [2.1, 1.7, -3]], atol=1e-12)
+    np.testing.assert_allclose(
+        fk.positions[0], [[2, 1, -3], [2, 1.7, -3], [2.1, 1.7, -3]], atol=1e-12
+    )
     np.testing.assert_allclose(fk.rotations[0, 0], [[0, 0, 1], [0, 1, 0], [-1, 0, 0]], atol=1e-12)
 
 
@@ -98,9 +100,13 @@ def _two_axis(order):
 def test_rotation_order_matters_hand_computed():
     angles = [[90 * DEG, 90 * DEG]]  # Z then X channel values
     # Intrinsic ZXY: Rz(90) @ Rx(90) takes +X to +Y.
-    np.testing.assert_allclose(forward_kinematics(_two_axis("ZXY"), angles).positions[0, 1], [0, 1, 0], atol=1e-12)
+    np.testing.assert_allclose(
+        forward_kinematics(_two_axis("ZXY"), angles).positions[0, 1], [0, 1, 0], atol=1e-12
+    )
     # Intrinsic XZY: Rx(90) @ Rz(90) takes +X to +Z.
-    np.testing.assert_allclose(forward_kinematics(_two_axis("XZY"), angles).positions[0, 1], [0, 0, 1], atol=1e-12)
+    np.testing.assert_allclose(
+        forward_kinematics(_two_axis("XZY"), angles).positions[0, 1], [0, 0, 1], atol=1e-12
+    )
 
 
 def test_chain_with_mixed_rotation_orders_hand_computed():
@@ -136,7 +142,9 @@ def test_bone_axis_conjugates_the_motion_rotation():
 
 
 def test_position_channels_replace_offset_components():
-    sk = Skeleton(["root", "child"], [-1, 0], [[5, 6, 7], [0, 1, 0]], [["Yposition"], ["Xposition"]])
+    sk = Skeleton(
+        ["root", "child"], [-1, 0], [[5, 6, 7], [0, 1, 0]], [["Yposition"], ["Xposition"]]
+    )
     fk = forward_kinematics(sk, [[2.0, 3.0]])
     # root: (5, 2, 7) with Y replaced; child: root + (3, 1, 0) with X replaced.
     np.testing.assert_allclose(fk.positions[0], [[5, 2, 7], [8, 3, 7]])
@@ -201,7 +209,9 @@ def test_single_frame_as_1d_and_shape_errors(skeleton):
 @pytest.mark.parametrize("order", ["XYZ", "ZXY", "YZX", "ZYX"])
 def test_euler_round_trip(order, rng):
     angles = rng.uniform(-1.2, 1.2, size=(10, 3))
-    np.testing.assert_allclose(matrix_to_euler(euler_to_matrix(angles, order), order), angles, atol=1e-10)
+    np.testing.assert_allclose(
+        matrix_to_euler(euler_to_matrix(angles, order), order), angles, atol=1e-10
+    )
 
 
 @pytest.mark.parametrize("order", ["XYZ", "XZY", "YXZ", "YZX", "ZXY", "ZYX"])
@@ -209,4 +219,6 @@ def test_euler_to_matrix_matches_scipy_intrinsic(order, rng):
     from scipy.spatial.transform import Rotation
 
     angles = rng.uniform(-np.pi, np.pi, size=(200, 3))
-    np.testing.assert_allclose(euler_to_matrix(angles, order), Rotation.from_euler(order, angles).as_matrix(), atol=1e-14)
+    np.testing.assert_allclose(
+        euler_to_matrix(angles, order), Rotation.from_euler(order, angles).as_matrix(), atol=1e-14
+    )

@@ -9,7 +9,12 @@ from skmotion.kinematics import Skeleton
 def test_structure(skeleton):
     assert skeleton.n_joints == 5
     assert skeleton.n_channels == 14
-    assert skeleton.channel_names[:4] == ["root_Xposition", "root_Yposition", "root_Zposition", "root_Zrotation"]
+    assert skeleton.channel_names[:4] == [
+        "root_Xposition",
+        "root_Yposition",
+        "root_Zposition",
+        "root_Zrotation",
+    ]
     assert skeleton.rotation_orders == ("ZXY", "XYZ", "YZX", "ZYX", "XYZ")
     assert skeleton.children("spine") == (2, 3)
     assert skeleton.end_sites == (4,)  # only "hand" has neither channels nor children
@@ -38,7 +43,9 @@ def test_scaled(skeleton):
 
 
 def test_repr_is_short(skeleton):
-    assert repr(skeleton) == "Skeleton(n_joints=5, n_channels=14, root='root', up_axis='y', units='m')"
+    assert (
+        repr(skeleton) == "Skeleton(n_joints=5, n_channels=14, root='root', up_axis='y', units='m')"
+    )
 
 
 @pytest.mark.parametrize(
@@ -59,7 +66,12 @@ def test_repr_is_short(skeleton):
     ],
 )
 def test_invalid_skeletons(kwargs, match):
-    base = dict(joints=["a", "b"], parents=[-1, 0], offsets=[[0, 0, 0], [1, 0, 0]], channels=[["Xrotation"], []])
+    base = dict(
+        joints=["a", "b"],
+        parents=[-1, 0],
+        offsets=[[0, 0, 0], [1, 0, 0]],
+        channels=[["Xrotation"], []],
+    )
     base.update(kwargs)
     if "joints" in kwargs and "parents" not in kwargs:
         base["parents"] = [-1] + [0] * (len(kwargs["joints"]) - 1)

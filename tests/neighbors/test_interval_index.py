@@ -88,7 +88,9 @@ grid = st.integers(-8, 8).map(lambda v: v / 8)
 def index_case(draw):
     n_levels = draw(st.integers(1, 4))
     edges = [np.array(sorted(draw(st.sets(grid, max_size=5)))) for _ in range(n_levels)]
-    radius = np.array([draw(st.sampled_from([0.0, 0.125, 0.25, 0.3, 0.6])) for _ in range(n_levels)])
+    radius = np.array(
+        [draw(st.sampled_from([0.0, 0.125, 0.25, 0.3, 0.6])) for _ in range(n_levels)]
+    )
     vector = st.lists(grid | st.floats(-1.5, 1.5), min_size=n_levels, max_size=n_levels)
     items = np.array(draw(st.lists(vector, min_size=1, max_size=25)), dtype=float)
     queries = np.array(draw(st.lists(vector, min_size=1, max_size=10)), dtype=float)
@@ -141,7 +143,9 @@ def test_one_query_path_equals_the_batched_path(seed, n_levels, max_entries):
     rng = np.random.default_rng(seed)
     items = rng.normal(size=(60, n_levels))
     radius = rng.uniform(0.0, 0.5, size=n_levels)
-    edges = [entry_edges(items[:, i].min(), items[:, i].max(), 0.3, max_entries) for i in range(n_levels)]
+    edges = [
+        entry_edges(items[:, i].min(), items[:, i].max(), 0.3, max_entries) for i in range(n_levels)
+    ]
     index = IntervalIndex(edges, radius)
     index.insert(items[:40])
     # Queries: random, far outside the range, and exactly on entry boundaries.
@@ -152,4 +156,6 @@ def test_one_query_path_equals_the_batched_path(seed, n_levels, max_entries):
     np.testing.assert_array_equal(one_by_one, batched)
     # Still equal after more items grew the tables.
     index.insert(items[40:])
-    np.testing.assert_array_equal([index.leaf_of(q[None])[0] for q in queries], index._leaf_of_batch(queries))
+    np.testing.assert_array_equal(
+        [index.leaf_of(q[None])[0] for q in queries], index._leaf_of_batch(queries)
+    )

@@ -9,7 +9,13 @@ from sklearn.utils.estimator_checks import parametrize_with_checks
 
 from skmotion.datasets import load_uea, make_motions, make_repeated_motions
 from skmotion.decomposition import SVDFeatureExtractor
-from skmotion.metrics import make_pruning_scorer, pruning_efficiency, pruning_scorer, recall, recall_scorer
+from skmotion.metrics import (
+    make_pruning_scorer,
+    pruning_efficiency,
+    pruning_scorer,
+    recall,
+    recall_scorer,
+)
 from skmotion.neighbors import IntervalIndexNeighbors, pairwise_psi
 from skmotion.neighbors._interval_neighbors import learn_delta
 from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
@@ -17,7 +23,9 @@ from tests.neighbors.test_interval_index import brute_force_candidates
 
 
 def _clips():
-    data = make_motions(n_clips_per_class=3, classes=["walk", "wave", "squat"], duration=(1.0, 1.5), random_state=0)
+    data = make_motions(
+        n_clips_per_class=3, classes=["walk", "wave", "squat"], duration=(1.0, 1.5), random_state=0
+    )
     return [c[:, 6:] for c in data.clips], data.target_names[data.target]
 
 
@@ -29,7 +37,9 @@ def _clips():
             param_grid={"epsilon": [0.8, 1.2], "n_levels": [2, 3]},
         ),
         ClipCase(
-            IntervalIndexNeighbors(n_levels=2, n_neighbors=3, features=SVDFeatureExtractor(weighting="first_two")),
+            IntervalIndexNeighbors(
+                n_levels=2, n_neighbors=3, features=SVDFeatureExtractor(weighting="first_two")
+            ),
             _clips,
         ),
     ]
@@ -45,7 +55,9 @@ def test_sklearn_checks_on_feature_vectors(estimator, check):
 
 @pytest.fixture(scope="module")
 def repeated():
-    data = make_repeated_motions(n_motions_per_class=3, n_repeats=4, duration=(1.5, 2.5), random_state=0)
+    data = make_repeated_motions(
+        n_motions_per_class=3, n_repeats=4, duration=(1.5, 2.5), random_state=0
+    )
     return data.clips, data.target
 
 
@@ -67,10 +79,14 @@ def test_delta_equals_a_loop_over_the_labels(seed, n_labels, quantile):
     features = rng.normal(size=(40, 3))
     labels = rng.choice([f"m{i}" for i in range(n_labels)], size=40)
     spreads = [
-        np.ptp(features[labels == g], axis=0) for g in np.unique(labels) if np.count_nonzero(labels == g) > 1
+        np.ptp(features[labels == g], axis=0)
+        for g in np.unique(labels)
+        if np.count_nonzero(labels == g) > 1
     ]
     expected = np.quantile(spreads, quantile, axis=0) if spreads else np.zeros(3)
-    np.testing.assert_allclose(learn_delta(features, labels, quantile), expected, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        learn_delta(features, labels, quantile), expected, rtol=1e-12, atol=1e-15
+    )
 
 
 def _brute_force(index, queries):
@@ -85,7 +101,9 @@ def _brute_force(index, queries):
     st.sampled_from([0.5, 1.0]),
     st.sampled_from([3, 64]),
 )
-def test_candidates_are_the_overlapping_clips_at_every_level(seed, n_levels, epsilon, quantile, max_entries):
+def test_candidates_are_the_overlapping_clips_at_every_level(
+    seed, n_levels, epsilon, quantile, max_entries
+):
     rng = np.random.default_rng(seed)
     X = rng.normal(size=(40, 5))
     y = rng.integers(0, 4, size=40)
@@ -98,7 +116,10 @@ def test_candidates_are_the_overlapping_clips_at_every_level(seed, n_levels, eps
     # With epsilon >= 1 and the paper's delta, stored clips find every clip of their label.
     if epsilon >= 1 and quantile == 1.0:
         for i, f in enumerate(index.candidates()):
-            np.testing.assert_array_equal(np.intersect1d(f, np.flatnonzero(y == y[i])), np.setdiff1d(np.flatnonzero(y == y[i]), [i]))
+            np.testing.assert_array_equal(
+                np.intersect1d(f, np.flatnonzero(y == y[i])),
+                np.setdiff1d(np.flatnonzero(y == y[i]), [i]),
+            )
 
 
 def test_recall_is_one_by_construction_on_clips(repeated):
@@ -162,7 +183,10 @@ def test_predict_votes_among_neighbours(repeated):
     proba = index.predict_proba(clips[:8])
     neighbours = index.kneighbors(clips[:8], return_distance=False)
     for row, ids in zip(proba, neighbours):
-        expected = np.bincount(np.searchsorted(index.classes_, target[ids]), minlength=len(index.classes_)) / 3
+        expected = (
+            np.bincount(np.searchsorted(index.classes_, target[ids]), minlength=len(index.classes_))
+            / 3
+        )
         np.testing.assert_allclose(row, expected)
     np.testing.assert_array_equal(index.predict(clips[:8]), index.classes_[proba.argmax(axis=1)])
 
@@ -170,7 +194,9 @@ def test_predict_votes_among_neighbours(repeated):
 def test_insert_adds_clips_without_rebuilding(repeated):
     clips, target = repeated
     # The first 30 clips hold 8 of the 21 motions: the others are new labels.
-    index = IntervalIndexNeighbors(n_levels=5, epsilon=0.9).partial_fit(clips[:30], target[:30], classes=target)
+    index = IntervalIndexNeighbors(n_levels=5, epsilon=0.9).partial_fit(
+        clips[:30], target[:30], classes=target
+    )
     edges = [e.copy() for e in index.index_.edges]
     index.insert(clips[30:], target[30:])
     assert index.n_samples_fit_ == len(clips)
@@ -180,7 +206,9 @@ def test_insert_adds_clips_without_rebuilding(repeated):
     assert [c.tolist() for c in index.candidates(clips)] == _brute_force(index, queries)
     np.testing.assert_array_equal(index.labels_, target)
     # Inserting clip by clip gives the same index.
-    one_by_one = IntervalIndexNeighbors(n_levels=5, epsilon=0.9).partial_fit(clips[:30], target[:30], classes=target)
+    one_by_one = IntervalIndexNeighbors(n_levels=5, epsilon=0.9).partial_fit(
+        clips[:30], target[:30], classes=target
+    )
     for i in range(30, len(clips)):
         one_by_one.partial_fit(clips[i : i + 1], target[i : i + 1])
     for a, b in zip(one_by_one.candidates(clips), index.candidates(clips)):
@@ -208,7 +236,11 @@ def test_grid_search_over_epsilon_and_n_levels_with_the_scorers(repeated):
     search = GridSearchCV(
         IntervalIndexNeighbors(),
         {"epsilon": [0.6, 1.2], "n_levels": [3, 5]},
-        scoring={"pruning": pruning_scorer, "recall": recall_scorer, "bounded": make_pruning_scorer(0.95)},
+        scoring={
+            "pruning": pruning_scorer,
+            "recall": recall_scorer,
+            "bounded": make_pruning_scorer(0.95),
+        },
         refit="bounded",
         cv=GroupKFold(4),
     ).fit(clips, target, groups=groups)

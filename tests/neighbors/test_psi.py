@@ -32,7 +32,9 @@ def test_hand_worked():
     assert psi(Q, P, k=1) == pytest.approx(1 / np.sqrt(2), abs=1e-12)
 
 
-clip = arrays(np.float64, st.tuples(st.integers(3, 25), st.just(5)), elements=st.floats(-4, 4, width=32))
+clip = arrays(
+    np.float64, st.tuples(st.integers(3, 25), st.just(5)), elements=st.floats(-4, 4, width=32)
+)
 
 
 def _well_posed(*clips, k=3):
@@ -86,7 +88,9 @@ def test_pairwise_matches_psi_and_works_as_precomputed_distance():
     D = 1 - S
     np.fill_diagonal(D, np.inf)
     assert (data.target[D.argmin(axis=1)] == data.target).mean() >= 0.8
-    knn = KNeighborsClassifier(n_neighbors=1, metric="precomputed").fit(1 - S[:14, :14], data.target[:14])
+    knn = KNeighborsClassifier(n_neighbors=1, metric="precomputed").fit(
+        1 - S[:14, :14], data.target[:14]
+    )
     assert knn.predict(1 - S[14:, :14]).shape == (7,)
 
 

@@ -25,7 +25,11 @@ def repeated():
     number (the CV groups: every motion is in every fold).
     """
     data = make_motions(
-        n_clips_per_class=2, n_subjects=2, classes=["walk", "jump", "wave", "kick", "squat"], duration=(4.5, 4.5), random_state=0
+        n_clips_per_class=2,
+        n_subjects=2,
+        classes=["walk", "jump", "wave", "kick", "squat"],
+        duration=(4.5, 4.5),
+        random_state=0,
     )
     n = int(1.5 * data.frame_rate)
     segments, skeletons, motion, repetition = [], [], [], []
@@ -40,13 +44,19 @@ def repeated():
 
 def _search(pipe, X, y, groups):
     return GridSearchCV(
-        pipe, GRID, scoring=make_search_scorer(0.9), refit="pruning_at_recall", cv=GroupKFold(N_REPEATS)
+        pipe,
+        GRID,
+        scoring=make_search_scorer(0.9),
+        refit="pruning_at_recall",
+        cv=GroupKFold(N_REPEATS),
     ).fit(X, y, groups=groups)
 
 
 def _by_params(results, key):
     return {
-        (p["intervalindexneighbors__epsilon"], p["intervalindexneighbors__n_levels"]): results[key][i]
+        (p["intervalindexneighbors__epsilon"], p["intervalindexneighbors__n_levels"]): results[key][
+            i
+        ]
         for i, p in enumerate(results["params"])
     }
 
@@ -68,15 +78,27 @@ def test_grid_search_over_the_marker_pipeline_on_motions(repeated):
         assert pruning[(epsilon, 6)] > pruning[(epsilon, 3)]
     # The refit setting is the best bounded score, and it differs from the worst.
     best = max(bounded, key=bounded.get)
-    assert (search.best_params_["intervalindexneighbors__epsilon"], search.best_params_["intervalindexneighbors__n_levels"]) == best
+    assert (
+        search.best_params_["intervalindexneighbors__epsilon"],
+        search.best_params_["intervalindexneighbors__n_levels"],
+    ) == best
     assert bounded[best] > min(bounded.values())
     # An independent recomputation of the best setting's scores, fold by fold.
     scores = []
     for train, test in GroupKFold(N_REPEATS).split(motions, motion, repetition):
-        model = clone(pipe).set_params(**search.best_params_).fit([motions[i] for i in train], motion[train])
+        model = (
+            clone(pipe)
+            .set_params(**search.best_params_)
+            .fit([motions[i] for i in train], motion[train])
+        )
         markers = model[0].transform([motions[i] for i in test])
         candidates = model[-1].candidates(markers)
-        scores.append((pruning_efficiency(candidates, motion[test], motion[train]), recall(candidates, motion[test], motion[train])))
+        scores.append(
+            (
+                pruning_efficiency(candidates, motion[test], motion[train]),
+                recall(candidates, motion[test], motion[train]),
+            )
+        )
     np.testing.assert_allclose(np.mean(scores, axis=0), [pruning[best], found[best]])
     # The refit pipeline takes Motions and finds repetitions of the same motion.
     refit = search.best_estimator_
@@ -88,12 +110,18 @@ def test_plain_arrays_with_a_skeleton_give_the_same_search(repeated):
     segments, skeletons, rate, motion, repetition = repeated
     one = skeletons[0]
     on_arrays = _search(
-        make_pipeline(VirtualMarkerTransform(skeleton=one, frame_rate=rate), IntervalIndexNeighbors()),
-        segments, motion, repetition,
+        make_pipeline(
+            VirtualMarkerTransform(skeleton=one, frame_rate=rate), IntervalIndexNeighbors()
+        ),
+        segments,
+        motion,
+        repetition,
     )
     on_motions = _search(
         make_pipeline(VirtualMarkerTransform(), IntervalIndexNeighbors()),
-        as_motions(segments, [one] * len(segments), rate), motion, repetition,
+        as_motions(segments, [one] * len(segments), rate),
+        motion,
+        repetition,
     )
     for key in ("mean_test_pruning", "mean_test_recall", "mean_test_pruning_at_recall"):
         np.testing.assert_array_equal(on_arrays.cv_results_[key], on_motions.cv_results_[key])

@@ -8,7 +8,12 @@ from hypothesis import strategies as st
 from skmotion.datasets import make_walks
 from skmotion.io import as_motions
 from skmotion.planning import (
-    damped_ik, facing_pose, planar_step, plan_axes, rigid_root_velocity, skeleton_root_velocity,
+    damped_ik,
+    facing_pose,
+    plan_axes,
+    planar_step,
+    rigid_root_velocity,
+    skeleton_root_velocity,
 )
 from skmotion.preprocessing import VirtualMarkerTransform, marker_preset
 
@@ -46,8 +51,14 @@ def test_skeleton_jacobian_recovers_the_true_root_velocity(turning_walks):
         ms = marker_preset(sk)
         every = f[2:-2:8]  # central differences are one-sided at the ends
         targets = every[..., :3] @ plan_axes("y").T
-        q0 = facing_pose(sk, ms, targets, root=ms.names.index("pelvis"), left=ms.names.index("left_hip"),
-                         right=ms.names.index("right_hip"))
+        q0 = facing_pose(
+            sk,
+            ms,
+            targets,
+            root=ms.names.index("pelvis"),
+            left=ms.names.index("left_hip"),
+            right=ms.names.index("right_hip"),
+        )
         q, rms = damped_ik(sk, ms, targets, q0)
         assert rms.max() < 1e-4  # real poses: IK puts every marker back
         u = skeleton_root_velocity(sk, ms, q, every[..., 3:])
@@ -71,7 +82,12 @@ def test_ik_reaches_two_link_targets_exactly():
     from skmotion.kinematics import Skeleton
     from skmotion.preprocessing import MarkerSet
 
-    arm = Skeleton(["a", "b", "c"], [-1, 0, 1], [[0, 0, 0], [1, 0, 0], [1, 0, 0]], [["Zrotation"], ["Zrotation"], []])
+    arm = Skeleton(
+        ["a", "b", "c"],
+        [-1, 0, 1],
+        [[0, 0, 0], [1, 0, 0], [1, 0, 0]],
+        [["Zrotation"], ["Zrotation"], []],
+    )
     tip = MarkerSet([("tip", "c", (0, 0, 0))])
     angles = np.array([[0.3, 0.5], [1.0, -0.7], [-0.4, 1.2]])
     targets = tip.positions(arm, angles)
@@ -95,7 +111,9 @@ def test_rigid_fit_on_a_real_cmu_walk(shared_data):
     names = list(transformer.marker_names_)
     pelvis, left, right = (names.index(n) for n in ("pelvis", "left_hip", "right_hip"))
     width = f[:, left, 1] - f[:, right, 1]
-    truth = np.column_stack([f[:, pelvis, 3], f[:, pelvis, 4], -(f[:, left, 3] - f[:, right, 3]) / width])
+    truth = np.column_stack(
+        [f[:, pelvis, 3], f[:, pelvis, 4], -(f[:, left, 3] - f[:, right, 3]) / width]
+    )
     u = rigid_root_velocity(f[..., :3], f[..., 3:])
     speed = np.hypot(truth[:, 0], truth[:, 1]).mean()
     # Over the clip (several strides) the limbs' motion cancels: the mean velocity is the root's.

@@ -11,7 +11,9 @@ from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 def _clips():
     rng = np.random.default_rng(3)
     t = np.arange(80)
-    X = [np.c_[np.sin(t / (5 + i)), np.cos(t / 7)] + 0.1 * rng.normal(size=(80, 2)) for i in range(6)]
+    X = [
+        np.c_[np.sin(t / (5 + i)), np.cos(t / 7)] + 0.1 * rng.normal(size=(80, 2)) for i in range(6)
+    ]
     return X, np.array([0, 1] * 3)
 
 
@@ -69,7 +71,9 @@ def test_noise_is_reduced_and_the_peak_does_not_move():
 def test_short_clips_get_a_clear_error():
     needed = filter_min_frames(10, 0.25)
     assert needed == 34
-    with pytest.raises(ValueError, match="33 frames; a zero-phase Butterworth filter of order 10 needs at least 34"):
+    with pytest.raises(
+        ValueError, match="33 frames; a zero-phase Butterworth filter of order 10 needs at least 34"
+    ):
         lowpass_filter(np.zeros((33, 2)))
     X = [np.zeros((50, 2)), np.zeros((50, 2)), np.zeros((20, 2))]
     with pytest.raises(ValueError, match="clip 2 has 20 frame"):

@@ -19,14 +19,18 @@ from skmotion.preprocessing._marker_presets import _PRESETS
 
 
 def test_marker_positions_follow_the_link(skeleton, rng):
-    markers = MarkerSet([("a", "arm", (0.1, 0.2, -0.3)), ("b", "root", (0, 0, 0)), ("c", "hand", (0, 0.05, 0))])
+    markers = MarkerSet(
+        [("a", "arm", (0.1, 0.2, -0.3)), ("b", "root", (0, 0, 0)), ("c", "hand", (0, 0.05, 0))]
+    )
     channels = rng.normal(size=(4, skeleton.n_channels))
     fk = skeleton.forward_kinematics(channels)
     expected = fk.positions[:, 3] + fk.rotations[:, 3] @ np.array([0.1, 0.2, -0.3])
     positions = markers.positions(skeleton, channels)
     np.testing.assert_allclose(positions[:, 0], expected, atol=1e-12)
     np.testing.assert_allclose(positions[:, 1], fk.positions[:, 0], atol=1e-12)
-    np.testing.assert_allclose(positions[:, 2], fk.positions[:, 4] + fk.rotations[:, 4] @ [0, 0.05, 0], atol=1e-12)
+    np.testing.assert_allclose(
+        positions[:, 2], fk.positions[:, 4] + fk.rotations[:, 4] @ [0, 0.05, 0], atol=1e-12
+    )
 
 
 def test_marker_set_validates_and_round_trips(skeleton):
@@ -57,7 +61,9 @@ def test_humanoid_preset_by_hand():
     rest = markers.positions(sk, np.zeros((1, sk.n_channels)))[0] + np.array([0, 0.95, 0])
     at = dict(zip(markers.names, rest))
     np.testing.assert_allclose(at["left_knee"], [0.09, 0.48, 0.0], atol=1e-12)
-    np.testing.assert_allclose(at["left_thigh"], [0.09, 0.69, 0.0], atol=1e-12)  # half way down the femur
+    np.testing.assert_allclose(
+        at["left_thigh"], [0.09, 0.69, 0.0], atol=1e-12
+    )  # half way down the femur
     np.testing.assert_allclose(at["head_top"], [0.0, 1.75, 0.0], atol=1e-12)
     np.testing.assert_allclose(at["right_elbow"], [-0.19, 1.42 - 0.29, 0.0], atol=1e-12)
     # Offsets follow a scaled subject.
@@ -93,8 +99,13 @@ def test_same_marker_lands_on_the_same_body_part_on_every_skeleton(shared_data):
 
     cases = {
         "humanoid": (Motion(sk, np.zeros((1, sk.n_channels)), frame_rate=30), 0),
-        "cmu_asf": (read_amc(shared_data / "cmu-asfamc/02/02_01.amc",
-                             read_asf(shared_data / "cmu-asfamc/02/02.asf")), 0),
+        "cmu_asf": (
+            read_amc(
+                shared_data / "cmu-asfamc/02/02_01.amc",
+                read_asf(shared_data / "cmu-asfamc/02/02.asf"),
+            ),
+            0,
+        ),
         "common_bvh": (read_bvh(shared_data / "bvh-samples/AV_8Walk_Meredith_HVHA_Rep1.bvh"), 0),
         "character_creator": (read_bvh(shared_data / "cmu-bvh/07/07_05.bvh"), 30),
     }
@@ -107,16 +118,30 @@ def test_same_marker_lands_on_the_same_body_part_on_every_skeleton(shared_data):
         across = positions[names.index("left_hip")] - positions[names.index("right_hip")]
         assert across[0] > 0, preset
         for part in ("clavicle", "shoulder", "elbow", "wrist", "hip", "thigh", "knee"):
-            left, right = positions[names.index(f"left_{part}")], positions[names.index(f"right_{part}")]
+            left, right = (
+                positions[names.index(f"left_{part}")],
+                positions[names.index(f"right_{part}")],
+            )
             assert (left - right) @ across > 0, (preset, part)
         # Along the body the markers keep their anatomical order.
         h = dict(zip(names, heights[preset]))
-        assert h["head_top"] > h["head"] > h["neck"] > h["chest"] > h["spine"] > h["pelvis"] > h["left_knee"]
+        assert (
+            h["head_top"]
+            > h["head"]
+            > h["neck"]
+            > h["chest"]
+            > h["spine"]
+            > h["pelvis"]
+            > h["left_knee"]
+        )
         assert h["left_hip"] > h["left_thigh"] > h["left_knee"] > h["left_shin"] > h["left_ankle"]
         assert h["left_shoulder"] > h["left_elbow"] > h["left_wrist"]
     table = np.array(list(heights.values()))
     spread = table.max(axis=0) - table.min(axis=0)
-    trunk = [MARKER_NAMES.index(n) for n in ("head", "neck", "chest", "spine", "pelvis", "left_hip", "left_knee")]
+    trunk = [
+        MARKER_NAMES.index(n)
+        for n in ("head", "neck", "chest", "spine", "pelvis", "left_hip", "left_knee")
+    ]
     assert spread[trunk].max() < 0.08, dict(zip(np.array(MARKER_NAMES)[trunk], spread[trunk]))
     assert spread.max() < 0.15
 
@@ -127,6 +152,8 @@ def test_cmu_preset_on_a_constructed_asf_frame():
     offsets = [[0, 0, 0], [0, 0, 0], [1, -1, 0], [0, -4, 0], [0, -4, 0], [0, -0.5, 1], [0, 0, 0.5]]
     axes = euler_to_matrix(np.array([[0.3, 0.2, 0.1]] * len(names)), "ZYX")
     sk = Skeleton(names, [-1, 0, 1, 2, 3, 4, 5], offsets, [["Xrotation"]] * 6 + [[]], axes=axes)
-    markers = MarkerSet([("knee", "ltibia", (0, 0, 0)), ("thigh", "lfemur", 0.5 * np.array(offsets[3]))])
+    markers = MarkerSet(
+        [("knee", "ltibia", (0, 0, 0)), ("thigh", "lfemur", 0.5 * np.array(offsets[3]))]
+    )
     positions = markers.positions(sk, np.zeros((1, sk.n_channels)))[0]
     np.testing.assert_allclose(positions, [[1, -5, 0], [1, -3, 0]], atol=1e-12)

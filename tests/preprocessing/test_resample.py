@@ -42,7 +42,9 @@ def test_frame_rate_conversion_keeps_times():
 
 @given(st.integers(2, 300), st.floats(10, 240), st.floats(10, 240))
 def test_frame_rate_output_length_property(n, rate, target):
-    out = ResampleClips(frame_rate=rate, target_frame_rate=target).fit_transform([np.zeros((n, 1))])[0]
+    out = ResampleClips(frame_rate=rate, target_frame_rate=target).fit_transform(
+        [np.zeros((n, 1))]
+    )[0]
     duration = (n - 1) / rate
     # The last output frame lies within the clip and one more would not.
     assert (len(out) - 1) / target <= duration + 1e-9
@@ -94,11 +96,16 @@ def _labelled(lengths):
 
 @parametrize_with_clip_checks(
     [
-        ClipCase(ResampleClips(n_frames=6), lambda: _labelled([9, 12, 15, 10, 8, 20, 11, 14, 13]),
-                 param_grid={"n_frames": [4, 6]}),
-        ClipCase(ResampleClips(frame_rate=30, target_frame_rate=20, kind="cubic"),
-                 lambda: _labelled([9, 12, 15, 10, 8, 20, 11, 14, 13]),
-                 param_grid={"kind": ["linear", "cubic"]}),
+        ClipCase(
+            ResampleClips(n_frames=6),
+            lambda: _labelled([9, 12, 15, 10, 8, 20, 11, 14, 13]),
+            param_grid={"n_frames": [4, 6]},
+        ),
+        ClipCase(
+            ResampleClips(frame_rate=30, target_frame_rate=20, kind="cubic"),
+            lambda: _labelled([9, 12, 15, 10, 8, 20, 11, 14, 13]),
+            param_grid={"kind": ["linear", "cubic"]},
+        ),
         ClipCase(FlattenClips(), lambda: _labelled([7] * 9)),
     ]
 )

@@ -38,7 +38,13 @@ def reaches(poses, durations, holds=None):
 
 
 # Every channel reverses at every via-point: out and back.
-ZIGZAG = [[0, 0, 0, 0], [1.0, 0.5, -0.5, 0.8], [0.2, -0.3, 0.4, 0.1], [1.2, 0.6, -0.2, 1.0], [0.0, 0.1, 0.3, 0.2]]
+ZIGZAG = [
+    [0, 0, 0, 0],
+    [1.0, 0.5, -0.5, 0.8],
+    [0.2, -0.3, 0.4, 0.1],
+    [1.2, 0.6, -0.2, 1.0],
+    [0.0, 0.1, 0.3, 0.2],
+]
 
 
 def test_movement_energy_by_hand():
@@ -140,12 +146,15 @@ def test_zvc_needs_channels_to_cross_together():
     assert len(zvc_segments(clip, frame_rate=30, min_channels=1)) == 3
 
 
-@pytest.mark.parametrize("lag, window, frame_rate, expected", [
-    (6, 0.3, 30, 4),    # 0.2 s apart: together
-    (6, 0.1, 30, 0),    # the window is shorter than the lag
-    (6, 0.3, 10, 0),    # at 10 Hz six frames are 0.6 s
-    (12, 0.3, 30, 0),   # 0.4 s apart
-])
+@pytest.mark.parametrize(
+    "lag, window, frame_rate, expected",
+    [
+        (6, 0.3, 30, 4),  # 0.2 s apart: together
+        (6, 0.1, 30, 0),  # the window is shorter than the lag
+        (6, 0.3, 10, 0),  # at 10 Hz six frames are 0.6 s
+        (12, 0.3, 30, 0),  # 0.4 s apart
+    ],
+)
 def test_zvc_window_is_in_seconds(lag, window, frame_rate, expected):
     t = np.arange(180) / 30
     clip = np.c_[np.cos(np.pi * t), np.cos(np.pi * (t - lag / 30))]

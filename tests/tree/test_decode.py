@@ -6,7 +6,13 @@ import numpy as np
 import pytest
 from scipy.special import logsumexp
 
-from skmotion.tree import MotionTree, TransitionGraphs, beam_decode, exhaustive_viterbi, node_log_posterior
+from skmotion.tree import (
+    MotionTree,
+    TransitionGraphs,
+    beam_decode,
+    exhaustive_viterbi,
+    node_log_posterior,
+)
 
 
 @pytest.fixture(scope="module")
@@ -17,8 +23,13 @@ def model():
     rng.shuffle(frames[:70])
     offsets = np.array([0, 35, 70, 100])
     tree = MotionTree.build(frames, max_depth=3, min_samples_leaf=8, split="median")
-    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
-                                    graph_of_clip=[0, 0, 1], smoothing=0.5)
+    graphs = TransitionGraphs.count(
+        list(tree.iter_apply(frames)),
+        tree.n_nodes,
+        offsets=offsets,
+        graph_of_clip=[0, 0, 1],
+        smoothing=0.5,
+    )
     return tree, graphs, frames
 
 
@@ -29,7 +40,9 @@ def brute_force(tree, graphs, layer, clip, graph, prior):
     log_pt = np.log(graphs.matrix(layer, graph))
     out = []
     for seq in itertools.product(range(k), repeat=len(clip)):
-        score = sum(log_ps[t, n] for t, n in enumerate(seq)) + sum(log_pt[a, b] for a, b in zip(seq[:-1], seq[1:]))
+        score = sum(log_ps[t, n] for t, n in enumerate(seq)) + sum(
+            log_pt[a, b] for a, b in zip(seq[:-1], seq[1:])
+        )
         out.append(score)
     return np.sort(np.array(out))[::-1]
 
@@ -42,7 +55,9 @@ def test_exhaustive_viterbi_matches_enumeration(model, prior, graph):
     for layer in range(tree.n_layers):
         expected = brute_force(tree, graphs, layer, clip, graph, prior)
         expected = expected[np.isfinite(expected)][:4]
-        _, scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=4, node_prior=prior)
+        _, scores = exhaustive_viterbi(
+            tree, graphs, layer, clip, graph, n_paths=4, node_prior=prior
+        )
         np.testing.assert_allclose(scores[: len(expected)], expected)
 
 
@@ -54,14 +69,26 @@ def test_a_wide_beam_agrees_with_the_exhaustive_viterbi(model, prior, guided):
     wide = int(tree.n_nodes.max())
     guide = None
     if guided:  # the upper layers searched on a one-graph "global" graph
-        guide = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 100],
-                                       graph_of_clip=[0])
+        guide = TransitionGraphs.count(
+            list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 100], graph_of_clip=[0]
+        )
     for graph in (0, 1):
         for layer in range(tree.n_layers):
-            paths, scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [graph], layer=layer,
-                                        n_paths=wide, node_prior=prior, guide=guide)
-            ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
-                                                     node_prior=prior)
+            paths, scores = beam_decode(
+                tree,
+                graphs,
+                clip,
+                [0, len(clip)],
+                [0],
+                [graph],
+                layer=layer,
+                n_paths=wide,
+                node_prior=prior,
+                guide=guide,
+            )
+            ex_paths, ex_scores = exhaustive_viterbi(
+                tree, graphs, layer, clip, graph, n_paths=wide, node_prior=prior
+            )
             np.testing.assert_allclose(scores[0, 0], ex_scores)
             finite = np.isfinite(ex_scores)
             np.testing.assert_array_equal(paths[0][finite], ex_paths[finite])
@@ -69,23 +96,36 @@ def test_a_wide_beam_agrees_with_the_exhaustive_viterbi(model, prior, guided):
 
 @pytest.mark.parametrize("covariance_type", ["diag", "spherical", "full"])
 @pytest.mark.parametrize("dense", [True, False])
-def test_the_compiled_decoder_agrees_for_every_covariance_and_table(monkeypatch, covariance_type, dense):
+def test_the_compiled_decoder_agrees_for_every_covariance_and_table(
+    monkeypatch, covariance_type, dense
+):
     """Emissions of each covariance kind and both transition lookups, against the exhaustive Viterbi."""
     from skmotion.tree import _transitions
 
     rng = np.random.default_rng(5)
     frames = np.vstack([rng.normal(c, 1.0, size=(30, 3)) for c in (0, 4, 8)])
-    tree = MotionTree.build(frames, max_depth=3, min_samples_leaf=6, split="median", covariance_type=covariance_type)
+    tree = MotionTree.build(
+        frames, max_depth=3, min_samples_leaf=6, split="median", covariance_type=covariance_type
+    )
     if not dense:
         monkeypatch.setattr(_transitions, "_DENSE_LIMIT", 0)
-    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 45, 90],
-                                    graph_of_clip=[0, 1], smoothing=0.5)
+    graphs = TransitionGraphs.count(
+        list(tree.iter_apply(frames)),
+        tree.n_nodes,
+        offsets=[0, 45, 90],
+        graph_of_clip=[0, 1],
+        smoothing=0.5,
+    )
     assert (len(graphs.kernel_table(1)["dense"]) > 0) == dense
     clip = frames[[2, 33, 61, 80, 14]] + 0.3
     wide = int(tree.n_nodes.max())
     for graph in (0, 1):
-        paths, scores = beam_decode(tree, graphs, clip, [0, 5], [0], [graph], layer=-1, n_paths=wide, node_prior="layer")
-        ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, -1, clip, graph, n_paths=wide, node_prior="layer")
+        paths, scores = beam_decode(
+            tree, graphs, clip, [0, 5], [0], [graph], layer=-1, n_paths=wide, node_prior="layer"
+        )
+        ex_paths, ex_scores = exhaustive_viterbi(
+            tree, graphs, -1, clip, graph, n_paths=wide, node_prior="layer"
+        )
         np.testing.assert_allclose(scores[0, 0], ex_scores, rtol=1e-12)
         np.testing.assert_array_equal(paths[0], ex_paths)
 
@@ -103,7 +143,9 @@ def reference_beams(tree, graphs, clip, graph, n_paths, layer):
     beam = np.zeros((len(clip), 1), dtype=int)
     for depth in range(1, layer + 1):
         kids = tree.children(depth - 1)
-        cand = np.array([[kids[n, side] if n >= 0 else -1 for side in (0, 1) for n in row] for row in beam])
+        cand = np.array(
+            [[kids[n, side] if n >= 0 else -1 for side in (0, 1) for n in row] for row in beam]
+        )
         if cand.shape[1] <= n_paths:
             beam = cand
             continue
@@ -128,9 +170,20 @@ def test_the_compiled_beams_follow_their_definition(model, n_paths):
     clip = frames[rng.integers(0, 100, size=12)] + rng.normal(scale=0.5, size=(12, 2))
     for graph in (0, 1):
         for layer in range(1, tree.n_layers):
-            beam = _descend(tree, graphs, clip, np.array([0]), np.array([12]), np.array([graph]), layer=layer,
-                               n_paths=n_paths, node_prior="layer")
-            np.testing.assert_array_equal(beam, reference_beams(tree, graphs, clip, graph, n_paths, layer))
+            beam = _descend(
+                tree,
+                graphs,
+                clip,
+                np.array([0]),
+                np.array([12]),
+                np.array([graph]),
+                layer=layer,
+                n_paths=n_paths,
+                node_prior="layer",
+            )
+            np.testing.assert_array_equal(
+                beam, reference_beams(tree, graphs, clip, graph, n_paths, layer)
+            )
 
 
 @pytest.mark.parametrize("n_paths", [1, 2, 3])
@@ -158,7 +211,9 @@ def test_node_posteriors_are_normalised(model):
         log_ps = node_log_posterior(tree, graphs, -1, frames[::7] * 5, prior)  # far-away frames too
         np.testing.assert_allclose(logsumexp(log_ps, axis=2), 0.0, atol=1e-9)
     unvisited = graphs.visits(tree.n_layers - 1) == 0
-    assert np.isneginf(node_log_posterior(tree, graphs, -1, frames[:3], "graph").transpose(1, 0, 2)[:, unvisited]).all()
+    assert np.isneginf(
+        node_log_posterior(tree, graphs, -1, frames[:3], "graph").transpose(1, 0, 2)[:, unvisited]
+    ).all()
 
 
 @pytest.mark.parametrize("guided", [False, True])
@@ -167,11 +222,14 @@ def test_clips_of_different_lengths_decode_as_if_alone(model, guided):
     guide = graphs if guided else None  # graph 0 of it guides
     offsets = np.array([0, 1, 9, 30, 33])
     clips, problems = [0, 1, 2, 3, 2, 0], [0, 1, 1, 0, 0, 1]
-    paths, scores = beam_decode(tree, graphs, frames, offsets, clips, problems, layer=-1, n_paths=3, guide=guide)
+    paths, scores = beam_decode(
+        tree, graphs, frames, offsets, clips, problems, layer=-1, n_paths=3, guide=guide
+    )
     for i, (c, g) in enumerate(zip(clips, problems)):
         clip = frames[offsets[c] : offsets[c + 1]]
-        alone_paths, alone_scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [g], layer=-1, n_paths=3,
-                                                guide=guide)
+        alone_paths, alone_scores = beam_decode(
+            tree, graphs, clip, [0, len(clip)], [0], [g], layer=-1, n_paths=3, guide=guide
+        )
         np.testing.assert_allclose(scores[i], alone_scores[0], atol=1e-12)
         np.testing.assert_array_equal(paths[i][:, : len(clip)], alone_paths[0])
         assert (paths[i][:, len(clip) :] == -1).all()
@@ -211,14 +269,35 @@ def pruning_case(seed, score_layers):
     frames = rng.normal(size=(20 * n_clips, 3)) + np.repeat(centres, 20, axis=0)
     offsets = np.arange(0, 20 * n_clips + 1, 20)
     tree = MotionTree.build(frames, max_depth=4, min_samples_leaf=5, split="median")
-    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
-                                    graph_of_clip=np.arange(n_clips), smoothing=0.5)
-    guide = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
-                                   graph_of_clip=np.zeros(n_clips, dtype=int))
-    queries = frames + rng.normal(scale=0.5, size=frames.shape)  # every clip under every clip's graph
-    clip_of_problem, graph_of_problem = np.repeat(np.arange(n_clips), n_clips), np.tile(np.arange(n_clips), n_clips)
+    graphs = TransitionGraphs.count(
+        list(tree.iter_apply(frames)),
+        tree.n_nodes,
+        offsets=offsets,
+        graph_of_clip=np.arange(n_clips),
+        smoothing=0.5,
+    )
+    guide = TransitionGraphs.count(
+        list(tree.iter_apply(frames)),
+        tree.n_nodes,
+        offsets=offsets,
+        graph_of_clip=np.zeros(n_clips, dtype=int),
+    )
+    queries = frames + rng.normal(
+        scale=0.5, size=frames.shape
+    )  # every clip under every clip's graph
+    clip_of_problem, graph_of_problem = (
+        np.repeat(np.arange(n_clips), n_clips),
+        np.tile(np.arange(n_clips), n_clips),
+    )
     args = (tree, graphs, queries, offsets, clip_of_problem, graph_of_problem)
-    kwargs = dict(layer=-1, n_paths=3, node_prior="layer", guide=guide, normalise=False, score_layers=score_layers)
+    kwargs = dict(
+        layer=-1,
+        n_paths=3,
+        node_prior="layer",
+        guide=guide,
+        normalise=False,
+        score_layers=score_layers,
+    )
     full_paths, full = beam_decode(*args, **kwargs)
     paths, pruned = beam_decode(*args, **kwargs, prune=True)
     total, total_full = logsumexp(pruned, axis=2).sum(axis=1), logsumexp(full, axis=2).sum(axis=1)
@@ -255,14 +334,24 @@ def test_pruning_needs_a_guide(model):
 def copied_model():
     """A minimum-error tree whose small clusters stop early: leaves copied down into lower layers."""
     rng = np.random.default_rng(7)
-    frames = np.vstack([rng.normal(c, s, size=(n, 2)) for c, s, n in [(0, 0.3, 60), (5, 1.0, 12), (9, 0.5, 24)]])
+    frames = np.vstack(
+        [rng.normal(c, s, size=(n, 2)) for c, s, n in [(0, 0.3, 60), (5, 1.0, 12), (9, 0.5, 24)]]
+    )
     offsets = np.array([0, 40, 70, 96])
     tree = MotionTree.build(frames, max_depth=4, min_samples_leaf=6, split="min_error")
-    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
-                                    graph_of_clip=[0, 1, 1], smoothing=0.5)
-    guide = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets,
-                                   graph_of_clip=[0, 0, 0])
-    copies = [bool(np.isin(tree.layers[l], tree.layers[l - 1]).any()) for l in range(2, tree.n_layers)]
+    graphs = TransitionGraphs.count(
+        list(tree.iter_apply(frames)),
+        tree.n_nodes,
+        offsets=offsets,
+        graph_of_clip=[0, 1, 1],
+        smoothing=0.5,
+    )
+    guide = TransitionGraphs.count(
+        list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets, graph_of_clip=[0, 0, 0]
+    )
+    copies = [
+        bool(np.isin(tree.layers[l], tree.layers[l - 1]).any()) for l in range(2, tree.n_layers)
+    ]
     assert any(copies)  # the case this fixture exists for
     return tree, graphs, guide, frames
 
@@ -275,12 +364,24 @@ def test_every_scored_layer_agrees_with_the_exhaustive_viterbi(copied_model, pri
     clip = frames[[3, 61, 80, 90, 10, 65, 30]] + 0.1
     wide = int(tree.n_nodes.max())
     for graph in (0, 1):
-        paths, scores = beam_decode(tree, graphs, clip, [0, len(clip)], [0], [graph], layer=-1, n_paths=wide,
-                                    score_layers=tree.n_layers, node_prior=prior, guide=guide if guided else None)
+        paths, scores = beam_decode(
+            tree,
+            graphs,
+            clip,
+            [0, len(clip)],
+            [0],
+            [graph],
+            layer=-1,
+            n_paths=wide,
+            score_layers=tree.n_layers,
+            node_prior=prior,
+            guide=guide if guided else None,
+        )
         assert scores.shape == (1, tree.n_layers - 1, wide)
         for row, layer in enumerate(range(1, tree.n_layers)):
-            ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
-                                                     node_prior=prior)
+            ex_paths, ex_scores = exhaustive_viterbi(
+                tree, graphs, layer, clip, graph, n_paths=wide, node_prior=prior
+            )
             # the normaliser is subtracted as a per-clip sum: rounding is absolute, at the terms' scale
             np.testing.assert_allclose(scores[0, row], ex_scores, rtol=1e-12, atol=1e-9)
         finite = np.isfinite(ex_scores)
@@ -292,23 +393,44 @@ def test_scoring_several_layers_equals_scoring_each_alone(copied_model, n_paths)
     """Beams above a layer do not depend on which layers are scored: each row is that layer's own decode."""
     tree, graphs, guide, frames = copied_model
     rng = np.random.default_rng(n_paths)
-    clips = [frames[rng.integers(0, 96, size=n)] + rng.normal(scale=0.4, size=(n, 2)) for n in (9, 1, 14)]
+    clips = [
+        frames[rng.integers(0, 96, size=n)] + rng.normal(scale=0.4, size=(n, 2)) for n in (9, 1, 14)
+    ]
     stacked, offsets = np.vstack(clips), np.array([0, 9, 10, 24])
     problems = dict(clip_of_problem=[0, 0, 1, 1, 2, 2], graph_of_problem=[0, 1, 0, 1, 0, 1])
     for kwargs in (dict(guide=guide, node_prior="layer"), dict(node_prior="graph")):
-        paths, scores = beam_decode(tree, graphs, stacked, offsets, *problems.values(), layer=-1, n_paths=n_paths,
-                                    score_layers=3, **kwargs)
+        paths, scores = beam_decode(
+            tree,
+            graphs,
+            stacked,
+            offsets,
+            *problems.values(),
+            layer=-1,
+            n_paths=n_paths,
+            score_layers=3,
+            **kwargs,
+        )
         bottom = tree.n_layers - 1
         for row, layer in enumerate(range(bottom - 2, bottom + 1)):
-            alone_paths, alone = beam_decode(tree, graphs, stacked, offsets, *problems.values(), layer=layer,
-                                             n_paths=n_paths, **kwargs)
+            alone_paths, alone = beam_decode(
+                tree,
+                graphs,
+                stacked,
+                offsets,
+                *problems.values(),
+                layer=layer,
+                n_paths=n_paths,
+                **kwargs,
+            )
             np.testing.assert_allclose(scores[:, row], alone[:, 0], rtol=1e-12, atol=1e-9)
         np.testing.assert_array_equal(paths, alone_paths)
 
 
 def test_score_layers_stop_at_layer_one(model):
     tree, graphs, frames = model
-    _, scores = beam_decode(tree, graphs, frames[:6], [0, 6], [0], [0], layer=2, n_paths=2, score_layers=10)
+    _, scores = beam_decode(
+        tree, graphs, frames[:6], [0, 6], [0], [0], layer=2, n_paths=2, score_layers=10
+    )
     assert scores.shape == (1, 2, 2)  # layers 1 and 2
     with pytest.raises(ValueError, match="score_layers must be an int >= 1"):
         beam_decode(tree, graphs, frames[:6], [0, 6], [0], [0], layer=2, score_layers=0)
@@ -319,19 +441,37 @@ def test_low_rank_covariances_decode_as_the_full_factor():
     rng = np.random.default_rng(11)
     d = 48
     frames = np.vstack([rng.normal(c, 1.0, size=(24, d)) for c in (0.0, 2.0, 4.0)])
-    tree = MotionTree.build(frames, max_depth=3, min_samples_leaf=4, split="median", covariance_type="full")
+    tree = MotionTree.build(
+        frames, max_depth=3, min_samples_leaf=4, split="median", covariance_type="full"
+    )
     low = tree.kernel_gaussians()["lr_start"] >= 0
     assert low.any() and not low.all()  # both forms are exercised
-    graphs = TransitionGraphs.count(list(tree.iter_apply(frames)), tree.n_nodes, offsets=[0, 36, 72],
-                                    graph_of_clip=[0, 1], smoothing=0.5)
+    graphs = TransitionGraphs.count(
+        list(tree.iter_apply(frames)),
+        tree.n_nodes,
+        offsets=[0, 36, 72],
+        graph_of_clip=[0, 1],
+        smoothing=0.5,
+    )
     clip = frames[[2, 30, 50, 70, 5]] + rng.normal(scale=0.3, size=(5, d))
     wide = int(tree.n_nodes.max())
     for graph in (0, 1):
-        paths, scores = beam_decode(tree, graphs, clip, [0, 5], [0], [graph], layer=-1, n_paths=wide,
-                                    score_layers=tree.n_layers, node_prior="layer")
+        paths, scores = beam_decode(
+            tree,
+            graphs,
+            clip,
+            [0, 5],
+            [0],
+            [graph],
+            layer=-1,
+            n_paths=wide,
+            score_layers=tree.n_layers,
+            node_prior="layer",
+        )
         for row, layer in enumerate(range(1, tree.n_layers)):
-            ex_paths, ex_scores = exhaustive_viterbi(tree, graphs, layer, clip, graph, n_paths=wide,
-                                                     node_prior="layer")
+            ex_paths, ex_scores = exhaustive_viterbi(
+                tree, graphs, layer, clip, graph, n_paths=wide, node_prior="layer"
+            )
             np.testing.assert_allclose(scores[0, row], ex_scores, rtol=1e-10, atol=1e-8)
         finite = np.isfinite(ex_scores)
         np.testing.assert_array_equal(paths[0][finite], ex_paths[finite])

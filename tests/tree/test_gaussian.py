@@ -3,10 +3,15 @@
 import numpy as np
 import pytest
 from scipy.stats import multivariate_normal
-from sklearn.covariance import ledoit_wolf, ledoit_wolf_shrinkage as sk_shrinkage
+from sklearn.covariance import ledoit_wolf
+from sklearn.covariance import ledoit_wolf_shrinkage as sk_shrinkage
 
 from skmotion.tree._gaussian import (
-    Gaussians, centred_moments, estimate_covariance, ledoit_wolf_shrinkage, low_rank_covariance,
+    Gaussians,
+    centred_moments,
+    estimate_covariance,
+    ledoit_wolf_shrinkage,
+    low_rank_covariance,
 )
 
 
@@ -25,15 +30,21 @@ def test_ledoit_wolf_matches_sklearn(n, d):
     X = np.random.default_rng(n).normal(size=(n, d)) @ np.diag(np.linspace(0.1, 3, d))
     _, scatter, sq_norms = centred_moments(X)
     Xc = X - X.mean(0)
-    assert ledoit_wolf_shrinkage(scatter, sq_norms) == pytest.approx(sk_shrinkage(Xc, assume_centered=True))
+    assert ledoit_wolf_shrinkage(scatter, sq_norms) == pytest.approx(
+        sk_shrinkage(Xc, assume_centered=True)
+    )
     expected, _ = ledoit_wolf(Xc, assume_centered=True)
-    np.testing.assert_allclose(estimate_covariance(scatter, sq_norms, "full", 0.0), expected, atol=1e-12)
+    np.testing.assert_allclose(
+        estimate_covariance(scatter, sq_norms, "full", 0.0), expected, atol=1e-12
+    )
 
 
 def test_diag_and_spherical_add_the_regularisation():
     X = np.array([[0.0, 1.0, 5.0], [2.0, 1.0, 5.0], [4.0, 1.0, 5.0]])
     _, scatter, sq_norms = centred_moments(X)
-    np.testing.assert_allclose(estimate_covariance(scatter, sq_norms, "diag", 0.1), [8 / 3 + 0.1, 0.1, 0.1])
+    np.testing.assert_allclose(
+        estimate_covariance(scatter, sq_norms, "diag", 0.1), [8 / 3 + 0.1, 0.1, 0.1]
+    )
     assert estimate_covariance(scatter, sq_norms, "spherical", 0.1) == pytest.approx(8 / 9 + 0.1)
 
 
@@ -64,9 +75,13 @@ def test_log_pdf_matches_scipy(kind):
         dense = np.stack([c * np.eye(d) for c in covs])
     X = rng.normal(size=(7, d)) * 3
     got = Gaussians(means, covs, kind).log_pdf(X)
-    expected = np.stack([multivariate_normal(means[j], dense[j]).logpdf(X) for j in range(k)], axis=1)
+    expected = np.stack(
+        [multivariate_normal(means[j], dense[j]).logpdf(X) for j in range(k)], axis=1
+    )
     np.testing.assert_allclose(got, expected, rtol=1e-10)
-    np.testing.assert_allclose(Gaussians(means, covs, kind).log_pdf(X, [2, 0]), expected[:, [2, 0]], rtol=1e-10)
+    np.testing.assert_allclose(
+        Gaussians(means, covs, kind).log_pdf(X, [2, 0]), expected[:, [2, 0]], rtol=1e-10
+    )
 
 
 def test_unknown_kind():
@@ -83,6 +98,12 @@ def test_the_low_rank_form_is_the_full_estimate(n, d):
     assert len(vectors) == min(n - 1, d)
     np.testing.assert_allclose(vectors @ vectors.T, np.eye(len(vectors)), atol=1e-12)
     rebuilt = floor * np.eye(d) + vectors.T @ np.diag(values) @ vectors
-    expected = ledoit_wolf(X - mean, assume_centered=True)[0] + 1e-3 * np.eye(d) if n > 1 else 1e-3 * np.eye(d)
+    expected = (
+        ledoit_wolf(X - mean, assume_centered=True)[0] + 1e-3 * np.eye(d)
+        if n > 1
+        else 1e-3 * np.eye(d)
+    )
     np.testing.assert_allclose(rebuilt, expected, atol=1e-12)
-    np.testing.assert_allclose(rebuilt, estimate_covariance(scatter, sq_norms, "full", 1e-3), atol=1e-12)
+    np.testing.assert_allclose(
+        rebuilt, estimate_covariance(scatter, sq_norms, "full", 1e-3), atol=1e-12
+    )

@@ -20,19 +20,28 @@ def drop_root(clips):
 
 
 def small_motions():
-    data = make_motions(n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1)
+    data = make_motions(
+        n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1
+    )
     return drop_root(data.clips), data.target_names[data.target]
 
 
 @pytest.fixture(scope="module")
 def motions():
-    data = make_motions(n_clips_per_class=8, classes=["walk", "jog", "jump", "kick", "squat"], random_state=0)
+    data = make_motions(
+        n_clips_per_class=8, classes=["walk", "jog", "jump", "kick", "squat"], random_state=0
+    )
     return drop_root(data.clips), data.target_names[data.target], data.groups
 
 
 @parametrize_with_clip_checks(
-    [ClipCase(MotionTreeHMM(max_depth=3, min_samples_leaf=4), small_motions,
-              param_grid={"max_depth": [2, 3], "min_samples_leaf": [4, 8]})]
+    [
+        ClipCase(
+            MotionTreeHMM(max_depth=3, min_samples_leaf=4),
+            small_motions,
+            param_grid={"max_depth": [2, 3], "min_samples_leaf": [4, 8]},
+        )
+    ]
 )
 def test_conformance(check):
     check()
@@ -40,7 +49,9 @@ def test_conformance(check):
 
 def test_recognises_synthetic_motions_across_subjects(motions):
     X, y, groups = motions
-    scores = cross_val_score(MotionTreeHMM(max_depth=6, split="median"), X, y, groups=groups, cv=GroupKFold(4))
+    scores = cross_val_score(
+        MotionTreeHMM(max_depth=6, split="median"), X, y, groups=groups, cv=GroupKFold(4)
+    )
     assert scores.mean() >= 0.95
 
 
@@ -69,9 +80,19 @@ def test_generation_probabilities_match_the_exhaustive_reference(motions, graph)
     model = MotionTreeHMM(max_depth=3, min_samples_leaf=30, n_paths=8, graph=graph).fit(X, y)
     assert model.n_nodes_.max() <= 8  # n_paths covers every node: the beam prunes nothing
     query = [(X[0][::3] - model.center_) / model.scale_, (X[5][:7] - model.center_) / model.scale_]
-    per_graph = np.array([[logsumexp(exhaustive_viterbi(model.tree_, model.graphs_, -1, q, g, n_paths=8,
-                                                        node_prior="layer")[1])
-                           for g in range(len(model.graph_classes_))] for q in query])
+    per_graph = np.array(
+        [
+            [
+                logsumexp(
+                    exhaustive_viterbi(
+                        model.tree_, model.graphs_, -1, q, g, n_paths=8, node_prior="layer"
+                    )[1]
+                )
+                for g in range(len(model.graph_classes_))
+            ]
+            for q in query
+        ]
+    )
     expected = np.full((2, len(model.classes_)), -np.inf)
     for g, c in enumerate(model.graph_classes_):  # a class scores as its best graph
         expected[:, c] = np.maximum(expected[:, c], per_graph[:, g])
@@ -95,7 +116,9 @@ def test_decode_and_predict_next_follow_the_global_graph(motions):
     nxt = model.predict_next([clip], n_steps=2, n_best=4)
     np.testing.assert_array_equal(nxt.nodes[0], np.argsort(-future, kind="stable")[:4])
     np.testing.assert_allclose(nxt.probabilities[0], np.sort(future)[::-1][:4])
-    np.testing.assert_allclose(nxt.means[0], model.tree_.means(layer)[nxt.nodes[0]] * model.scale_ + model.center_)
+    np.testing.assert_allclose(
+        nxt.means[0], model.tree_.means(layer)[nxt.nodes[0]] * model.scale_ + model.center_
+    )
 
 
 def test_sliding_window_profiles(motions):
@@ -112,8 +135,9 @@ def test_sliding_window_profiles(motions):
 
 def test_classifying_at_an_upper_layer(motions):
     X, y, groups = motions
-    scores = cross_val_score(MotionTreeHMM(max_depth=8, layer=5, split="median"), X, y, groups=groups,
-                             cv=GroupKFold(4))
+    scores = cross_val_score(
+        MotionTreeHMM(max_depth=8, layer=5, split="median"), X, y, groups=groups, cv=GroupKFold(4)
+    )
     assert scores.mean() >= 0.9
     with pytest.raises(ValueError, match="layer 20 does not exist"):
         MotionTreeHMM(max_depth=3, layer=20).fit(X, y)
@@ -137,7 +161,9 @@ def test_hard_cases_give_finite_answers(score_layers):
     y = ["a", "a", "b", "b", "c"]  # class "c" has one clip of two frames
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        model = MotionTreeHMM(min_samples_leaf=1, n_paths=5, covariance_type="full", score_layers=score_layers)
+        model = MotionTreeHMM(
+            min_samples_leaf=1, n_paths=5, covariance_type="full", score_layers=score_layers
+        )
         model.fit(X, y)
         for query in ([X[3]], [X[4]], [rng.normal(size=(1, 12)) * 100], [np.zeros((3, 12))]):
             assert np.isfinite(model.score_samples(query)).all()
@@ -178,10 +204,13 @@ def marker_search():
     """A GridSearchCV over depth and leaf size on virtual markers, with its data and folds."""
     from skmotion.preprocessing import VirtualMarkerTransform
 
-    data = make_motions(n_clips_per_class=4, classes=["walk", "jump", "squat"], duration=(1.0, 1.5),
-                        random_state=3)
-    pipe = make_pipeline(VirtualMarkerTransform(skeleton=data.skeleton, frame_rate=data.frame_rate),
-                         MotionTreeHMM(n_paths=2))
+    data = make_motions(
+        n_clips_per_class=4, classes=["walk", "jump", "squat"], duration=(1.0, 1.5), random_state=3
+    )
+    pipe = make_pipeline(
+        VirtualMarkerTransform(skeleton=data.skeleton, frame_rate=data.frame_rate),
+        MotionTreeHMM(n_paths=2),
+    )
     grid = {"motiontreehmm__max_depth": [2, 5], "motiontreehmm__min_samples_leaf": [4, 24]}
     splits = list(GroupKFold(2).split(data.clips, data.target, data.groups))
     search = GridSearchCV(pipe, grid, cv=splits).fit(data.clips, data.target)
@@ -198,12 +227,16 @@ def test_grid_search_on_virtual_markers_equals_a_manual_loop(marker_search):
     for params in ParameterGrid(search.param_grid):
         folds = []
         for train, test in splits:
-            model = clone(search.estimator).set_params(**params).fit([X[i] for i in train], y[train])
+            model = (
+                clone(search.estimator).set_params(**params).fit([X[i] for i in train], y[train])
+            )
             folds.append(np.mean(model.predict([X[i] for i in test]) == y[test]))
         manual.append((params, np.mean(folds)))
     assert [p for p, _ in manual] == list(search.cv_results_["params"])
     np.testing.assert_allclose([s for _, s in manual], search.cv_results_["mean_test_score"])
-    best = max(range(len(manual)), key=lambda i: (manual[i][1], -i))  # the first of the best, as sklearn
+    best = max(
+        range(len(manual)), key=lambda i: (manual[i][1], -i)
+    )  # the first of the best, as sklearn
     assert search.best_params_ == manual[best][0]
     # the refit model is the best setting fitted on all clips
     refit = clone(search.estimator).set_params(**manual[best][0]).fit(X, y)
@@ -215,9 +248,15 @@ def test_the_fitted_marker_pipeline_pickles(marker_search):
 
     search, data, _ = marker_search
     restored = pickle.loads(pickle.dumps(search.best_estimator_))
-    np.testing.assert_array_equal(restored.predict(data.clips), search.best_estimator_.predict(data.clips))
-    np.testing.assert_array_equal(restored.predict_proba(data.clips), search.best_estimator_.predict_proba(data.clips))
-    np.testing.assert_array_equal(restored.score_samples(data.clips), search.best_estimator_.score_samples(data.clips))
+    np.testing.assert_array_equal(
+        restored.predict(data.clips), search.best_estimator_.predict(data.clips)
+    )
+    np.testing.assert_array_equal(
+        restored.predict_proba(data.clips), search.best_estimator_.predict_proba(data.clips)
+    )
+    np.testing.assert_array_equal(
+        restored.score_samples(data.clips), search.best_estimator_.score_samples(data.clips)
+    )
 
 
 @pytest.mark.parametrize("n_paths", [1, 3])  # 1: predict takes the best-score pass alone
@@ -225,7 +264,9 @@ def test_the_fitted_marker_pipeline_pickles(marker_search):
 def test_pruned_predict_agrees_with_full_scoring(motions, graph, n_paths):
     X, y, _ = motions
     model = MotionTreeHMM(max_depth=4, n_paths=n_paths, graph=graph).fit(X[::2], y[::2])
-    np.testing.assert_array_equal(model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)])
+    np.testing.assert_array_equal(
+        model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)]
+    )
 
 
 def test_several_scored_layers_multiply_their_generation_probabilities(motions):
@@ -233,11 +274,16 @@ def test_several_scored_layers_multiply_their_generation_probabilities(motions):
     X, y, _ = motions
     model = MotionTreeHMM(max_depth=5, split="median", score_layers=3).fit(X[::2], y[::2])
     np.testing.assert_array_equal(model.score_layers_, [3, 4, 5])
-    per_layer = [MotionTreeHMM(max_depth=5, split="median", layer=layer).fit(X[::2], y[::2]) for layer in (3, 4, 5)]
+    per_layer = [
+        MotionTreeHMM(max_depth=5, split="median", layer=layer).fit(X[::2], y[::2])
+        for layer in (3, 4, 5)
+    ]
     expected = np.sum([m.score_samples(X[1::3]) for m in per_layer], axis=0)
     np.testing.assert_allclose(model.score_samples(X[1::3]), expected, rtol=1e-10)
     log_prob = model.score_samples(X[:5])
-    np.testing.assert_allclose(model.predict_proba(X[:5]), np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True)))
+    np.testing.assert_allclose(
+        model.predict_proba(X[:5]), np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True))
+    )
 
 
 @pytest.mark.parametrize("graph", ["class", "clip"])
@@ -245,7 +291,9 @@ def test_pruned_predict_over_several_layers_agrees_with_full_scoring(motions, gr
     # with clip graphs a class scores as its best clip's product over the layers
     X, y, _ = motions
     model = MotionTreeHMM(max_depth=5, n_paths=3, score_layers=3, graph=graph).fit(X[::2], y[::2])
-    np.testing.assert_array_equal(model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)])
+    np.testing.assert_array_equal(
+        model.predict(X), model.classes_[np.argmax(model.score_samples(X), axis=1)]
+    )
 
 
 def test_score_layers_all_and_beyond_the_tree(motions):

@@ -30,10 +30,14 @@ def check_partition(tree, frames):
         assert counts.sum() == n
         sums = np.zeros((tree.n_nodes[layer], frames.shape[1]))
         np.add.at(sums, labels, frames)
-        np.testing.assert_allclose(sums / counts[:, None], tree.means(layer), atol=1e-9 * (1 + np.abs(frames).max()))
+        np.testing.assert_allclose(
+            sums / counts[:, None], tree.means(layer), atol=1e-9 * (1 + np.abs(frames).max())
+        )
         if layer:
             parents = tree.parents(layer)
-            np.testing.assert_array_equal(np.bincount(parents, weights=counts), tree.counts(layer - 1))
+            np.testing.assert_array_equal(
+                np.bincount(parents, weights=counts), tree.counts(layer - 1)
+            )
             np.testing.assert_array_equal(parents[labels], previous)
         previous = labels
 
@@ -41,7 +45,9 @@ def check_partition(tree, frames):
 @pytest.mark.parametrize("split", SPLIT_CRITERIA)
 @pytest.mark.parametrize("covariance_type", ["diag", "full", "spherical"])
 def test_layers_partition_the_frames(split, covariance_type, motion_frames):
-    tree = MotionTree.build(motion_frames, split=split, covariance_type=covariance_type, max_depth=6)
+    tree = MotionTree.build(
+        motion_frames, split=split, covariance_type=covariance_type, max_depth=6
+    )
     check_partition(tree, motion_frames)
     assert tree.n_layers <= 7
 
@@ -88,7 +94,10 @@ def test_leaves_are_copied_down(rng):
                 assert kids[k, 1] == -1 and tree.node_ids(layer + 1)[kids[k, 0]] == node
                 assert node in bottom
             else:
-                assert list(tree.node_ids(layer + 1)[kids[k]]) == [tree.left[node], tree.right[node]]
+                assert list(tree.node_ids(layer + 1)[kids[k]]) == [
+                    tree.left[node],
+                    tree.right[node],
+                ]
     assert (tree.children(-1) == -1).all()
     assert tree.n_tree_nodes == 2 * len(bottom) - 1
 
@@ -140,7 +149,9 @@ def test_covariances_carry_the_regularisation(rng):
     scale = frames.var(axis=0).mean()
     labels = tree.apply(frames, 2)
     for k in range(tree.n_nodes[2]):
-        np.testing.assert_allclose(tree.covariances(2)[k], frames[labels == k].var(axis=0) + 1e-3 * scale)
+        np.testing.assert_allclose(
+            tree.covariances(2)[k], frames[labels == k].var(axis=0) + 1e-3 * scale
+        )
 
 
 @pytest.mark.parametrize(

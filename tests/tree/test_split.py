@@ -20,7 +20,11 @@ def direct_scores(v, criterion, var_floor=0.0):
         if criterion == "min_error":
             v1 = max(np.var(left), var_floor, np.finfo(float).tiny)
             v2 = max(np.var(right), var_floor, np.finfo(float).tiny)
-            out.append(i * np.log(v1) + (n - i) * np.log(v2) - 2 * (i * np.log(i) + (n - i) * np.log(n - i)))
+            out.append(
+                i * np.log(v1)
+                + (n - i) * np.log(v2)
+                - 2 * (i * np.log(i) + (n - i) * np.log(n - i))
+            )
         elif criterion == "two_means":
             out.append(np.sum((left - left.mean()) ** 2) + np.sum((right - right.mean()) ** 2))
         else:
@@ -34,7 +38,10 @@ def test_min_error_matches_its_definition(v):
     scale = max(np.ptp(v), 1.0)
     floor = (1e-6 * scale) ** 2  # keeps log() away from rounding noise of zero variances
     np.testing.assert_allclose(
-        split_scores(v, "min_error", var_floor=floor), direct_scores(v, "min_error", floor), rtol=1e-6, atol=1e-4
+        split_scores(v, "min_error", var_floor=floor),
+        direct_scores(v, "min_error", floor),
+        rtol=1e-6,
+        atol=1e-4,
     )
 
 
@@ -60,7 +67,9 @@ def test_min_error_cuts_between_two_modes():
 def test_best_split_is_the_best_admissible_cut(criterion, v, leaf, tol):
     v = np.sort(np.round(v))  # rounding makes ties and small gaps common
     m = best_split(v, criterion, min_samples_leaf=leaf, tol=tol)
-    admissible = [i for i in range(1, len(v)) if i >= leaf and len(v) - i >= leaf and v[i] - v[i - 1] > tol]
+    admissible = [
+        i for i in range(1, len(v)) if i >= leaf and len(v) - i >= leaf and v[i] - v[i - 1] > tol
+    ]
     if not admissible:
         assert m is None
         return

@@ -7,8 +7,7 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from skmotion.tree import TransitionGraphs
-from skmotion.tree import _transitions
+from skmotion.tree import TransitionGraphs, _transitions
 
 
 def loop_counts(labels, offsets, graph_of_clip, n_graphs, k):
@@ -25,8 +24,12 @@ def clip_labels(draw):
     k = draw(st.integers(1, 6))
     lengths = draw(st.lists(st.integers(1, 12), min_size=1, max_size=6))
     n_graphs = draw(st.integers(1, 3))
-    graph_of_clip = np.array(draw(st.lists(st.integers(0, n_graphs - 1), min_size=len(lengths), max_size=len(lengths))))
-    labels = np.array(draw(st.lists(st.integers(0, k - 1), min_size=sum(lengths), max_size=sum(lengths))))
+    graph_of_clip = np.array(
+        draw(st.lists(st.integers(0, n_graphs - 1), min_size=len(lengths), max_size=len(lengths)))
+    )
+    labels = np.array(
+        draw(st.lists(st.integers(0, k - 1), min_size=sum(lengths), max_size=sum(lengths)))
+    )
     offsets = np.r_[0, np.cumsum(lengths)]
     return labels, offsets, graph_of_clip, n_graphs, k
 
@@ -34,8 +37,14 @@ def clip_labels(draw):
 @given(clip_labels(), st.floats(0.01, 5))
 def test_counts_and_probabilities(case, alpha):
     labels, offsets, graph_of_clip, n_graphs, k = case
-    graphs = TransitionGraphs.count([labels], [k], offsets=offsets, graph_of_clip=graph_of_clip,
-                                    n_graphs=n_graphs, smoothing=alpha)
+    graphs = TransitionGraphs.count(
+        [labels],
+        [k],
+        offsets=offsets,
+        graph_of_clip=graph_of_clip,
+        n_graphs=n_graphs,
+        smoothing=alpha,
+    )
     expected = loop_counts(labels, offsets, graph_of_clip, n_graphs, k)
     for g in range(n_graphs):
         np.testing.assert_array_equal(graphs.counts(0, g).toarray(), expected[g])
@@ -46,7 +55,9 @@ def test_counts_and_probabilities(case, alpha):
         # never-seen transitions hold exactly the smoothing mass of their row
         mass = (alpha / k) / (totals + alpha)
         np.testing.assert_array_equal(P[unseen], np.broadcast_to(mass, P.shape)[unseen])
-        np.testing.assert_allclose(P[~unseen], ((expected[g] + alpha / k) / (totals + alpha))[~unseen])
+        np.testing.assert_allclose(
+            P[~unseen], ((expected[g] + alpha / k) / (totals + alpha))[~unseen]
+        )
         np.testing.assert_allclose(graphs.unseen_probability(0)[g], mass[:, 0])
         nodes = np.arange(k)
         np.testing.assert_allclose(np.exp(graphs.log_prob(0, g, nodes[:, None], nodes[None])), P)
@@ -56,12 +67,16 @@ def test_counts_and_probabilities(case, alpha):
 
 
 def test_no_transition_crosses_a_clip_boundary():
-    graphs = TransitionGraphs.count([np.array([0, 0, 1, 1])], [2], offsets=[0, 2, 4], graph_of_clip=[0, 0])
+    graphs = TransitionGraphs.count(
+        [np.array([0, 0, 1, 1])], [2], offsets=[0, 2, 4], graph_of_clip=[0, 0]
+    )
     np.testing.assert_array_equal(graphs.counts(0, 0).toarray(), [[1, 0], [0, 1]])
 
 
 def test_a_node_never_left_has_a_uniform_row():
-    graphs = TransitionGraphs.count([np.array([0, 0, 1])], [3], offsets=[0, 3], graph_of_clip=[0], smoothing=0.5)
+    graphs = TransitionGraphs.count(
+        [np.array([0, 0, 1])], [3], offsets=[0, 3], graph_of_clip=[0], smoothing=0.5
+    )
     np.testing.assert_allclose(graphs.matrix(0, 0)[1], [1 / 3] * 3)
 
 
@@ -75,8 +90,14 @@ def dense_and_sparse(monkeypatch, labels, n_nodes, **args):
 
 
 def test_sparse_lookup_matches_the_dense_table(monkeypatch, rng):
-    dense, sparse = dense_and_sparse(monkeypatch, rng.integers(0, 7, size=200), 7, offsets=[0, 50, 120, 200],
-                                     graph_of_clip=[0, 1, 1], smoothing=0.3)
+    dense, sparse = dense_and_sparse(
+        monkeypatch,
+        rng.integers(0, 7, size=200),
+        7,
+        offsets=[0, 50, 120, 200],
+        graph_of_clip=[0, 1, 1],
+        smoothing=0.3,
+    )
     g, src, dst = rng.integers(0, 2, 300), rng.integers(-1, 8, 300), rng.integers(-1, 8, 300)
     np.testing.assert_array_equal(dense.log_prob(0, g, src, dst), sparse.log_prob(0, g, src, dst))
     assert np.isneginf(dense.log_prob(0, 0, [-1, 7, 2], [3, 3, 7])).all()
@@ -84,23 +105,35 @@ def test_sparse_lookup_matches_the_dense_table(monkeypatch, rng):
 
 def test_propagate_is_a_matrix_power(rng):
     labels = rng.integers(0, 5, size=80)
-    graphs = TransitionGraphs.count([labels], [5], offsets=[0, 80], graph_of_clip=[0], smoothing=0.2)
+    graphs = TransitionGraphs.count(
+        [labels], [5], offsets=[0, 80], graph_of_clip=[0], smoothing=0.2
+    )
     start = rng.dirichlet(np.ones(5), size=3)
     P = graphs.matrix(0, 0)
-    np.testing.assert_allclose(graphs.propagate(0, 0, start, 3), start @ np.linalg.matrix_power(P, 3))
+    np.testing.assert_allclose(
+        graphs.propagate(0, 0, start, 3), start @ np.linalg.matrix_power(P, 3)
+    )
     np.testing.assert_allclose(graphs.propagate(0, 0, start[0]), start[0] @ P)
 
 
 def test_smoothing_must_be_positive():
     with pytest.raises(ValueError, match="smoothing must be a positive number"):
-        TransitionGraphs.count([np.zeros(3, int)], [1], offsets=[0, 3], graph_of_clip=[0], smoothing=0)
+        TransitionGraphs.count(
+            [np.zeros(3, int)], [1], offsets=[0, 3], graph_of_clip=[0], smoothing=0
+        )
 
 
 def test_the_kernel_table_holds_every_log_probability(monkeypatch, rng):
     """The compiled decoder's lookups (dense table, or a pair's row of every graph and the unseen rows) give
     log_prob exactly."""
-    dense, sparse = dense_and_sparse(monkeypatch, rng.integers(0, 6, size=150), 6, offsets=[0, 40, 90, 150],
-                                     graph_of_clip=[0, 1, 2], smoothing=0.7)
+    dense, sparse = dense_and_sparse(
+        monkeypatch,
+        rng.integers(0, 6, size=150),
+        6,
+        offsets=[0, 40, 90, 150],
+        graph_of_clip=[0, 1, 2],
+        smoothing=0.7,
+    )
     for graphs, has_dense in ((dense, True), (sparse, False)):
         table = graphs.kernel_table(0)
         k, n_graphs = table["k"], table["n_graphs"]

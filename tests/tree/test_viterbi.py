@@ -13,17 +13,25 @@ def all_sequences(initial, steps, b):
     n_states, n_steps = initial.shape[0], len(steps) + 1
     out = []
     for seq in itertools.product(range(n_states), repeat=n_steps):
-        score = initial[seq[0], b] + sum(steps[t - 1, seq[t - 1], seq[t], b] for t in range(1, n_steps))
+        score = initial[seq[0], b] + sum(
+            steps[t - 1, seq[t - 1], seq[t], b] for t in range(1, n_steps)
+        )
         out.append((score, seq))
     return sorted(out, key=lambda item: -item[0])
 
 
 @st.composite
 def trellises(draw):
-    n_steps, n_states, n_problems = draw(st.integers(1, 5)), draw(st.integers(1, 3)), draw(st.integers(1, 3))
+    n_steps, n_states, n_problems = (
+        draw(st.integers(1, 5)),
+        draw(st.integers(1, 3)),
+        draw(st.integers(1, 3)),
+    )
     rng = np.random.default_rng(draw(st.integers(0, 2**16)))
     initial = np.log(rng.uniform(size=(n_states, n_problems)))
-    steps = np.round(np.log(rng.uniform(size=(n_steps - 1, n_states, n_states, n_problems))), 1)  # ties
+    steps = np.round(
+        np.log(rng.uniform(size=(n_steps - 1, n_states, n_states, n_problems))), 1
+    )  # ties
     initial[rng.uniform(size=initial.shape) < 0.2] = -np.inf
     steps[rng.uniform(size=steps.shape) < 0.2] = -np.inf
     return initial, steps
@@ -36,11 +44,13 @@ def test_kbest_matches_enumeration(trellis, n_paths):
     for b in range(initial.shape[1]):
         ranked = [s for s, _ in all_sequences(initial, steps, b) if np.isfinite(s)][:n_paths]
         np.testing.assert_allclose(scores[b, : len(ranked)], ranked)
-        assert np.isneginf(scores[b, len(ranked):]).all() and (paths[b, len(ranked):] == -1).all()
+        assert np.isneginf(scores[b, len(ranked) :]).all() and (paths[b, len(ranked) :] == -1).all()
         found = [tuple(p) for p in paths[b, : len(ranked)]]
         assert len(set(found)) == len(found), "sequences repeat"
         for seq, score in zip(found, scores[b]):
-            own = initial[seq[0], b] + sum(steps[t - 1, seq[t - 1], seq[t], b] for t in range(1, len(seq)))
+            own = initial[seq[0], b] + sum(
+                steps[t - 1, seq[t - 1], seq[t], b] for t in range(1, len(seq))
+            )
             assert np.isclose(own, score, rtol=1e-12)
 
 
@@ -59,7 +69,9 @@ def test_max_marginals_match_enumeration(trellis):
 def test_ten_thousand_steps_do_not_underflow():
     n_steps = 10_000
     initial = np.log([[0.5], [0.5]])
-    move = np.log(np.array([[0.9, 0.1], [0.1, 0.9]]) * np.array([0.8, 0.2]))  # arrival scores included
+    move = np.log(
+        np.array([[0.9, 0.1], [0.1, 0.9]]) * np.array([0.8, 0.2])
+    )  # arrival scores included
     steps = np.broadcast_to(move[None, :, :, None], (n_steps - 1, 2, 2, 1))
     paths, scores = kbest_viterbi(initial, steps, 2)
     assert np.isfinite(scores).all()

@@ -16,7 +16,10 @@ class _Est:
 def _frame(clips, labels=None):
     labels = range(len(clips)) if labels is None else labels
     return pd.concat(
-        {lab: pd.DataFrame(c, columns=[f"m{j}" for j in range(c.shape[1])]) for lab, c in zip(labels, clips)},
+        {
+            lab: pd.DataFrame(c, columns=[f"m{j}" for j in range(c.shape[1])])
+            for lab, c in zip(labels, clips)
+        },
         names=["clip", "frame"],
     )
 
@@ -40,7 +43,12 @@ def test_list_tuple_ndarray_dataframe_agree(clips):
 @pytest.mark.parametrize("kind", ["list", "tuple", "ndarray", "dataframe"])
 def test_round_trip_keeps_container(kind, clips):
     equal = [c[:3] for c in clips]
-    form = {"list": equal, "tuple": tuple(equal), "ndarray": np.stack(equal), "dataframe": _frame(equal, "abcde")}[kind]
+    form = {
+        "list": equal,
+        "tuple": tuple(equal),
+        "ndarray": np.stack(equal),
+        "dataframe": _frame(equal, "abcde"),
+    }[kind]
     checked = check_clips(form)
     back = to_container(list(checked), checked.container)
     if kind == "dataframe":
@@ -170,9 +178,7 @@ def test_channel_counts_differ(clips):
         check_clips(clips)
 
 
-@pytest.mark.parametrize(
-    "value, word", [(np.nan, "NaN"), (np.inf, "inf"), (-np.inf, "-inf")]
-)
+@pytest.mark.parametrize("value, word", [(np.nan, "NaN"), (np.inf, "inf"), (-np.inf, "-inf")])
 def test_non_finite_values_are_located(clips, value, word):
     clips[4][7, 2] = value
     with pytest.raises(ValueError, match=f"clip 4 contains {word} at frame 7, channel 2"):
@@ -197,7 +203,9 @@ def test_non_numeric_data(clips):
 
 
 def test_numeric_strings_and_objects_are_converted():
-    out = check_clips([np.array([["1.5", "2"], ["3", "4"]]), np.array([[1, 2], [3, 4]], dtype=object)])
+    out = check_clips(
+        [np.array([["1.5", "2"], ["3", "4"]]), np.array([[1, 2], [3, 4]], dtype=object)]
+    )
     np.testing.assert_array_equal(out[0], [[1.5, 2], [3, 4]])
 
 
