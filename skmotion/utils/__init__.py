@@ -1,4 +1,4 @@
-"""Utilities: the clip validator, container conversion, frame stacking, parallelism."""
+"""Utilities: the clip validator, container conversion, frame stacking, parallelism, progress."""
 
 from skmotion.utils._clips import (
     Clips,
@@ -9,12 +9,15 @@ from skmotion.utils._clips import (
     to_container,
 )
 from skmotion.utils._parallel import parallel_map
+from skmotion.utils._progress import progress, say
 
 __all__ = [
     "Clips",
     "Container",
     "check_clips",
     "parallel_map",
+    "progress",
+    "say",
     "split_frames",
     "stack_clips",
     "to_container",
