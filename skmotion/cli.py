@@ -29,12 +29,24 @@ def _demo(args):
     return 0
 
 
+def _marker_preset(skeleton):
+    """The ``marker preset`` line of ``skmotion info`` (presets live in preprocessing, not io)."""
+    from skmotion.preprocessing import detect_marker_preset
+
+    try:
+        return [f"marker preset: {detect_marker_preset(skeleton)}"]
+    except ValueError:
+        return ["marker preset: none fits (define a MarkerSet)"]
+
+
 def _info(args):
     from skmotion.io._info import describe_file
 
     try:
-        lines = describe_file(args.file, asf=args.asf)
-    except (OSError, ValueError) as exc:
+        lines = describe_file(
+            args.file, asf=args.asf, frame_rate=args.frame_rate, skeleton_notes=_marker_preset
+        )
+    except (OSError, ValueError, ImportError) as exc:
         print(f"skmotion info: {exc}", file=sys.stderr)
         return 1
     print("\n".join(lines))
@@ -75,12 +87,23 @@ def build_parser():
         help="save the sections' figures in DIR (needs matplotlib)",
     )
     demo.set_defaults(func=_demo)
+    from skmotion.io._info import formats_help
+
     info = commands.add_parser(
-        "info", help="print a motion file's skeleton, channels, frame rate and duration"
+        "info",
+        help="print a motion file's skeleton or markers, channels, frame rate and duration",
+        description="Formats read:\n" + formats_help(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    info.add_argument("file", help="a .bvh, .amc or .asf file")
+    info.add_argument("file", help="a motion file of a format listed above")
     info.add_argument(
         "--asf", default=None, help="the skeleton of an .amc file (default: NN.asf beside it)"
+    )
+    info.add_argument(
+        "--frame-rate",
+        type=float,
+        default=None,
+        help="frames per second of a file that does not record it (keypoint files)",
     )
     info.set_defaults(func=_info)
     return parser

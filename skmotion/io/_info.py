@@ -1,16 +1,16 @@
-"""What ``skmotion info FILE`` prints: a motion file's skeleton, channels, rate and duration."""
+"""What ``skmotion info FILE`` prints: skeleton or markers, channels, rate and duration."""
 
 from collections import Counter
 from pathlib import Path
 
-from skmotion.io._amc import read_amc
-from skmotion.io._asf import read_asf
-from skmotion.io._bvh import read_bvh
+import numpy as np
+
+from skmotion.io._formats import FORMATS, file_format
 
 __all__ = ["describe_file"]
 
 
-def _skeleton_lines(skeleton):
+def _skeleton_lines(skeleton, skeleton_notes):
     end_sites = len(skeleton.end_sites)
     unit = (
         skeleton.units
@@ -21,41 +21,83 @@ def _skeleton_lines(skeleton):
         o for o, c in zip(skeleton.rotation_orders, skeleton.channels) if any("rot" in x for x in c)
     )
     lines = [
-        f"skeleton: {skeleton.n_joints} joints ({skeleton.n_joints - end_sites} with channels or children, "
-        f"{end_sites} end sites), root {skeleton.joints[0]!r}, {skeleton.up_axis}-up, length unit {unit}",
+        f"skeleton: {skeleton.n_joints} joints ({skeleton.n_joints - end_sites} with channels or "
+        f"children, {end_sites} end sites), root {skeleton.joints[0]!r}, {skeleton.up_axis}-up, "
+        f"length unit {unit}",
         f"rest-pose height: {skeleton.height():.4g} units",
         "rotation orders (intrinsic): " + ", ".join(f"{o} x{n}" for o, n in orders.most_common()),
     ]
-    try:
-        from skmotion.preprocessing import detect_marker_preset
-
-        lines.append(f"marker preset: {detect_marker_preset(skeleton)}")
-    except ValueError:
-        lines.append("marker preset: none fits (define a MarkerSet)")
+    # What the skeleton means elsewhere (the CLI adds its marker preset): io knows no presets.
+    if skeleton_notes is not None:
+        lines += list(skeleton_notes(skeleton))
     return lines
 
 
-def _find_asf(amc):
+def _shown(names, n=6):
+    return ", ".join(names[:n]) + (f", ... ({len(names) - n} more)" if len(names) > n else "")
+
+
+def _position_lines(motion, rate_known):
+    positions = motion.channels.reshape(motion.n_frames, len(motion.marker_names), -1)
+    missing = np.isnan(positions).any(axis=2)
+    lines = [
+        f"markers: {len(motion.marker_names)} ({motion.n_dims}-D, length unit {motion.units}): "
+        + _shown(list(motion.marker_names)),
+        f"missing: {missing.mean():.1%} of marker positions; "
+        f"{int(missing.all(axis=0).sum())} markers never seen",
+    ]
+    lines += [f"extras: {', '.join(motion.extras)}"] if motion.extras else []
+    if rate_known:
+        return lines + [_frames_line(motion)]
+    return lines + [f"frames: {motion.n_frames} (no frame rate in the file; give --frame-rate)"]
+
+
+def _frames_line(motion):
+    rate, duration = f"{motion.frame_rate:g}", f"{motion.duration:.2f}"
+    return f"frames: {motion.n_frames} at {rate} Hz, duration {duration} s"
+
+
+def _series_lines(row, path):
+    clips, labels = row.reader(path)
+    lengths = [len(c) for c in clips]
+    lines = [
+        f"series: {len(clips)}, {clips[0].shape[1]} dimensions, "
+        f"length {min(lengths)}-{max(lengths)}"
+        if clips
+        else "series: none",
+    ]
+    if labels is not None:
+        counts = Counter(labels.tolist())
+        lines.append("labels: " + ", ".join(f"{k} {n}" for k, n in sorted(counts.items())))
+    return lines
+
+
+def _find_skeleton(amc, suffix):
     subject = amc.stem.split("_")[0]
-    candidates = [amc.with_name(f"{subject}.asf")] + sorted(amc.parent.glob("*.asf"))
+    candidates = [amc.with_name(f"{subject}{suffix}")] + sorted(amc.parent.glob(f"*{suffix}"))
     for candidate in candidates:
         if candidate.is_file():
             return candidate
     raise FileNotFoundError(
-        f"No skeleton for {amc}: give --asf (no {subject}.asf or other .asf beside it)."
+        f"No skeleton for {amc}: give --asf (no {subject}{suffix} or other {suffix} beside it)."
     )
 
 
-def describe_file(path, *, asf=None):
-    """The lines ``skmotion info`` prints for a ``.bvh``, ``.amc`` or ``.asf`` file.
+def describe_file(path, *, asf=None, frame_rate=None, skeleton_notes=None):
+    """The lines ``skmotion info`` prints for a motion file of any format in :data:`FORMATS`.
 
     Parameters
     ----------
     path : str or path-like
-        The file.
+        The file; its suffix picks the reader (:func:`file_format`).
     asf : str or path-like, default=None
         The skeleton of an ``.amc`` file; by default ``NN.asf`` (or the only
         ``.asf``) beside it.
+    frame_rate : float, default=None
+        Frames per second of a file that does not record it (keypoints).
+    skeleton_notes : callable, default=None
+        ``skeleton_notes(skeleton)`` gives further lines about a skeleton
+        (the command adds its marker preset).
 
     Returns
     -------
@@ -78,32 +120,50 @@ def describe_file(path, *, asf=None):
     frames: 88 at 30 Hz, duration 2.93 s
     """
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix == ".asf":
-        skeleton = read_asf(path)
+    row = file_format(path)
+    head = [f"file: {path}", f"format: {row.name}"]
+    if row.kind == "series":
+        return head + _series_lines(row, path)
+    if row.kind == "skeleton":
+        skeleton = row.reader(path)
         return [
-            f"file: {path}",
-            "format: Acclaim skeleton (ASF)",
-            *_skeleton_lines(skeleton),
+            *head,
+            *_skeleton_lines(skeleton, skeleton_notes),
             f"channels: {skeleton.n_channels} (an AMC frame of this skeleton)",
         ]
-    if suffix == ".amc":
-        asf = Path(asf) if asf is not None else _find_asf(path)
-        motion = read_amc(path, read_asf(asf))
-        kind = f"Acclaim motion (AMC), skeleton {asf}; frame rate not recorded in AMC files: CMU's 120 Hz"
-    elif suffix == ".bvh":
-        motion = read_bvh(path)
-        kind = "BVH"
+    if row.skeleton_suffix is not None:
+        asf = Path(asf) if asf is not None else _find_skeleton(path, row.skeleton_suffix)
+        motion = row.reader(path, file_format(asf).reader(asf))
+        head[1] += f", skeleton {asf}; frame rate not recorded in AMC files: CMU's 120 Hz"
+    elif row.needs_frame_rate:
+        motion = row.reader(path, frame_rate=frame_rate or 1.0)
     else:
-        raise ValueError(
-            f"{path}: unknown motion file type {suffix!r} (expected .bvh, .amc or .asf)"
-        )
-    names = motion.channel_names
-    shown = ", ".join(names[:6]) + (f", ... ({len(names) - 6} more)" if len(names) > 6 else "")
+        motion = row.reader(path)
+    if motion.kind == "positions":
+        return head + _position_lines(motion, frame_rate is not None or not row.needs_frame_rate)
     return [
-        f"file: {path}",
-        f"format: {kind}",
-        *_skeleton_lines(motion.skeleton),
-        f"channels: {motion.n_channels}: {shown}",
-        f"frames: {motion.n_frames} at {motion.frame_rate:g} Hz, duration {motion.duration:.2f} s",
+        *head,
+        *_skeleton_lines(motion.skeleton, skeleton_notes),
+        f"channels: {motion.n_channels}: {_shown(motion.channel_names)}",
+        _frames_line(motion),
     ]
+
+
+def formats_help():
+    """One line per format of :data:`FORMATS`, for help texts.
+
+    Returns
+    -------
+    text : str
+
+    Examples
+    --------
+    >>> from skmotion.io._info import formats_help
+    >>> print(formats_help().splitlines()[0])
+    .bvh  BVH: skeleton and joint angles
+    """
+    return "\n".join(
+        f"{row.suffix:<5} {row.name}: {row.description}"
+        + (f" (extra '{row.extra}')" if row.extra else "")
+        for row in FORMATS
+    )

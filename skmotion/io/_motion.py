@@ -8,6 +8,10 @@ from skmotion.kinematics import Skeleton, forward_kinematics
 
 __all__ = ["Motion", "as_motions"]
 
+#: Metres per unit of the length units position files state (C3D ``POINT:UNITS``).
+METERS_PER_UNIT = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
+_AXES = ("x", "y", "z")
+
 
 class Motion:
     """One motion clip with its skeleton: what the file readers return.
@@ -17,17 +21,33 @@ class Motion:
     estimator; :class:`~skmotion.preprocessing.VirtualMarkerTransform` also
     uses each motion's own skeleton and frame rate.
 
+    A motion of **positions** (markers from a C3D file, keypoints of a
+    tracker) has no skeleton: ``skeleton=None`` and ``marker_names`` name its
+    points; its channels are ``x, y[, z]`` per point, named
+    ``"<marker>_x"``, ``"<marker>_y"``, ``"<marker>_z"``, NaN where a point is
+    missing. ``VirtualMarkerTransform`` treats it as marker-position input.
+
     Parameters
     ----------
-    skeleton : Skeleton
-        The joint hierarchy the channels drive.
+    skeleton : Skeleton or None
+        The joint hierarchy the channels drive; None for positions.
     channels : array-like of shape (n_frames, n_channels)
         Channel values in ``skeleton.channel_names`` order: angles in radians,
-        positions in the skeleton's length unit.
+        positions in the skeleton's length unit. For positions, 2 or 3
+        columns per marker, marker after marker.
     frame_rate : float
         Frames per second.
     source : str, default=None
         Where the motion came from (a file path), for messages and reports.
+    marker_names : sequence of str, default=None
+        The points of a position motion (required when ``skeleton`` is None).
+    units : str, default=None
+        Length unit of a position motion (``"m"``, ``"mm"``, ``"px"``, ...);
+        None is ``"unknown"``. A skeleton motion's unit is its skeleton's.
+    extras : dict of str to ndarray, default=None
+        Further per-frame data kept from the file, each array with
+        ``n_frames`` rows: a C3D file's ``"residuals"``, a keypoint file's
+        ``"confidence"`` (one column per marker).
 
     Attributes
     ----------
@@ -37,6 +57,12 @@ class Motion:
         Number of frames.
     duration : float
         ``n_frames / frame_rate`` seconds.
+    kind : {"angles", "positions"}
+        ``"positions"`` when there is no skeleton.
+    n_dims : int or None
+        2 or 3 coordinates per marker of a position motion; None for angles.
+    meters_per_unit : float or None
+        Metres per length unit, when the unit is known.
 
     See Also
     --------
@@ -54,13 +80,34 @@ class Motion:
     Motion(n_frames=60, n_channels=66, frame_rate=30.0, source=None)
     >>> np.asarray(motion).shape, motion.duration
     ((60, 66), 2.0)
+
+    Two markers tracked in millimetres:
+
+    >>> points = Motion(None, np.zeros((4, 6)), frame_rate=100, marker_names=["LASI", "RASI"],
+    ...                 units="mm")
+    >>> points.channel_names[:4], points.kind, points.meters_per_unit
+    (['LASI_x', 'LASI_y', 'LASI_z', 'RASI_x'], 'positions', 0.001)
     """
 
-    def __init__(self, skeleton, channels, *, frame_rate, source=None):
-        if not isinstance(skeleton, Skeleton):
-            raise TypeError(f"skeleton must be a Skeleton, got {type(skeleton).__name__}.")
+    def __init__(
+        self,
+        skeleton,
+        channels,
+        *,
+        frame_rate,
+        source=None,
+        marker_names=None,
+        units=None,
+        extras=None,
+    ):
         channels = np.array(channels, dtype=float, order="C")
-        if channels.ndim != 2 or channels.shape[1] != skeleton.n_channels:
+        if skeleton is None:
+            marker_names = _check_markers(marker_names, channels)
+        elif not isinstance(skeleton, Skeleton):
+            raise TypeError(f"skeleton must be a Skeleton or None, got {type(skeleton).__name__}.")
+        elif marker_names is not None or units is not None:
+            raise ValueError("marker_names and units are for position motions (skeleton=None).")
+        elif channels.ndim != 2 or channels.shape[1] != skeleton.n_channels:
             raise ValueError(
                 f"channels must have shape (n_frames, {skeleton.n_channels}) for this skeleton; "
                 f"got {channels.shape}."
@@ -68,7 +115,8 @@ class Motion:
         if not isinstance(frame_rate, Real) or isinstance(frame_rate, bool):
             # A string or None is not parsed or guessed: say what was given.
             raise TypeError(
-                f"frame_rate must be a number of Hz, got {type(frame_rate).__name__} {frame_rate!r}."
+                f"frame_rate must be a number of Hz, got {type(frame_rate).__name__} "
+                f"{frame_rate!r}."
             )
         frame_rate = float(frame_rate)
         if not frame_rate > 0 or not np.isfinite(frame_rate):
@@ -77,10 +125,31 @@ class Motion:
         self.channels = channels
         self.frame_rate = frame_rate
         self.source = None if source is None else str(source)
+        self.marker_names = marker_names
+        self.units = (skeleton.units if skeleton is not None else None) or units or "unknown"
+        self.extras = _check_extras(extras, len(channels))
 
     @property
     def channel_names(self):
+        if self.skeleton is None:
+            return [f"{m}_{a}" for m in self.marker_names for a in _AXES[: self.n_dims]]
         return list(self.skeleton.channel_names)
+
+    @property
+    def kind(self):
+        return "positions" if self.skeleton is None else "angles"
+
+    @property
+    def n_dims(self):
+        if self.skeleton is None:
+            return self.channels.shape[1] // len(self.marker_names)
+        return None
+
+    @property
+    def meters_per_unit(self):
+        if self.skeleton is not None:
+            return self.skeleton.meters_per_unit
+        return METERS_PER_UNIT.get(self.units)
 
     @property
     def n_frames(self):
@@ -107,6 +176,11 @@ class Motion:
         result : FKResult
             See :func:`skmotion.kinematics.forward_kinematics`.
         """
+        if self.skeleton is None:
+            raise ValueError(
+                f"{self.source or 'this motion'} holds positions of {len(self.marker_names)} "
+                "markers, not joint angles: it has no skeleton to pose."
+            )
         return forward_kinematics(self.skeleton, self.channels)
 
     def __repr__(self):
@@ -114,6 +188,32 @@ class Motion:
             f"Motion(n_frames={self.n_frames}, n_channels={self.n_channels}, "
             f"frame_rate={self.frame_rate!r}, source={self.source!r})"
         )
+
+
+def _check_markers(marker_names, channels):
+    """The marker names of a position motion, checked against its channel array."""
+    if marker_names is None:
+        raise ValueError("A position motion (skeleton=None) needs marker_names.")
+    names = tuple(str(m) for m in marker_names)
+    if not names or len(set(names)) != len(names):
+        raise ValueError(f"marker_names must be unique and not empty; got {list(names)[:8]}.")
+    n = len(names)
+    if channels.ndim != 2 or channels.shape[1] not in (2 * n, 3 * n):
+        raise ValueError(
+            f"channels must have shape (n_frames, {3 * n}) (x, y, z per marker) or (n_frames, "
+            f"{2 * n}) (x, y) for {n} markers; got {channels.shape}."
+        )
+    return names
+
+
+def _check_extras(extras, n_frames):
+    extras = dict(extras or {})
+    for key, value in extras.items():
+        value = np.asarray(value)
+        if value.ndim < 1 or len(value) != n_frames:
+            raise ValueError(f"extras[{key!r}] must have {n_frames} rows (one per frame).")
+        extras[key] = value
+    return extras
 
 
 def as_motions(clips, skeletons, frame_rate, *, sources=None):

@@ -1,0 +1,313 @@
+"""Reading keypoint files: joint positions per frame from trackers and pose estimators.
+
+The joint names come from a *layout*: any object with a ``joint_names``
+sequence (the layouts of :mod:`skmotion.preprocessing` have one), or a layout
+name that :func:`skmotion.preprocessing.get_layout` resolves when called.
+"""
+
+import io
+from pathlib import Path
+
+import numpy as np
+
+from skmotion.io._errors import MotionFileError
+from skmotion.io._motion import Motion
+from skmotion.io._text import read_bytes
+
+__all__ = ["read_keypoints"]
+
+# Values per joint by default: 2 -> x, y; 3 -> x, y, z; 4 -> x, y, z and a confidence.
+_DEFAULT_COLUMNS = {2: "xy", 3: "xyz", 4: "xyzc"}
+_COLUMNS = ("xy", "xyz", "xyc", "xyzc")
+
+
+def _joint_names(layout):
+    """The joint names of ``layout`` (None, a layout name or an object with ``joint_names``)."""
+    if layout is None:
+        return None
+    if isinstance(layout, str):
+        # Resolved when called, so that io imports nothing from preprocessing at import time.
+        from skmotion.preprocessing import get_layout
+
+        layout = get_layout(layout)
+    names = getattr(layout, "joint_names", None)
+    if names is None:
+        raise TypeError(
+            f"layout must be None, a layout name or an object with joint_names; got "
+            f"{type(layout).__name__}."
+        )
+    return [str(n) for n in names]
+
+
+def _is_number(word):
+    """Whether numpy.loadtxt reads ``word`` as a finite float (no ``1_000``, no infinity)."""
+    try:
+        return "_" not in word and not np.isinf(float(word))
+    except ValueError:
+        return False
+
+
+def _find_bad_line(path, lines, delimiter, first, n_values):
+    """The MotionFileError naming the first line of ``lines[first:]`` that does not parse."""
+    for number, line in enumerate(lines[first:], start=first + 1):
+        text = line.split("#", 1)[0].strip()
+        if not text:
+            continue
+        words = [w.strip() for w in text.split(delimiter)]
+        if n_values is not None and len(words) != n_values:
+            return MotionFileError(path, number, f"{len(words)} values, expected {n_values}")
+        bad = next((w for w in words if not _is_number(w)), None)
+        if bad is not None:
+            return MotionFileError(path, number, f"not a finite number: {bad!r}")
+    return MotionFileError(path, None, "cannot be read as a table of numbers")
+
+
+def _read_text(path):
+    """(values of shape (n_rows, n_values), header names or None) of a text table."""
+    text = read_bytes(path).decode("utf-8-sig", errors="replace")
+    lines = text.splitlines()
+    data_lines = [k for k, line in enumerate(lines) if line.split("#", 1)[0].strip()]
+    if not data_lines:
+        raise MotionFileError(path, None, "no data lines")
+    first = data_lines[0]
+    delimiter = "," if "," in lines[first] else None
+    words = [w.strip() for w in lines[first].split("#", 1)[0].split(delimiter)]
+    header = None
+    if not all(_is_number(w) for w in words) and not any(_is_number(w) for w in words):
+        header, first = words, first + 1
+    n_values = len(words) if header else None
+    try:
+        values = np.loadtxt(
+            io.StringIO("\n".join(lines[first:])),
+            delimiter=delimiter,
+            comments="#",
+            ndmin=2,
+            dtype=float,
+        )
+    except ValueError:
+        raise _find_bad_line(path, lines, delimiter, first, n_values) from None
+    if values.size == 0:
+        raise MotionFileError(path, None, "no data lines")
+    if (header and values.shape[1] != len(header)) or np.isinf(values).any():
+        raise _find_bad_line(path, lines, delimiter, first, n_values or values.shape[1])
+    return values, header
+
+
+def _read_array(path):
+    """(values, joint names or None, confidence or None) of a ``.npy`` or ``.npz`` file."""
+    try:
+        loaded = np.load(path, allow_pickle=False)
+    except (ValueError, OSError) as exc:
+        raise MotionFileError(path, None, f"not a NumPy array file ({exc})") from None
+    if not isinstance(loaded, np.lib.npyio.NpzFile):
+        return loaded, None, None
+    with loaded:
+        keys = set(loaded.files)
+        main = [k for k in ("keypoints", "positions") if k in keys]
+        if not main:
+            main = sorted(keys - {"confidence", "joint_names"})
+        if len(main) != 1:
+            raise MotionFileError(
+                path, None, f"expected an array 'keypoints' (or one array); found {sorted(keys)}"
+            )
+        names = loaded["joint_names"].tolist() if "joint_names" in keys else None
+        confidence = loaded["confidence"] if "confidence" in keys else None
+        return loaded[main[0]], names, confidence
+
+
+def _joints_from_header(path, header, n_values):
+    """Joint names from column names ``<joint>_<x|y|z|c...>``, checked group by group."""
+    if len(header) % n_values:
+        raise MotionFileError(path, 1, f"{len(header)} columns, not {n_values} per joint")
+    groups = np.asarray(header, dtype=object).reshape(-1, n_values)
+    names = []
+    for group in groups:
+        stems = {str(c).rsplit("_", 1)[0] for c in group}
+        if len(stems) != 1:
+            raise MotionFileError(
+                path, 1, f"columns {list(group)} do not name one joint (<joint>_x, <joint>_y, ...)"
+            )
+        names.append(stems.pop())
+    return names
+
+
+def _as_frames(path, values, names, columns, per_line):
+    """Values reshaped to (n_frames, n_joints, n_values)."""
+    if values.dtype.kind not in "fiu" or values.ndim not in (2, 3):
+        raise MotionFileError(
+            path,
+            None,
+            f"expected numbers of shape (n_frames, n_joints, n_values) or (n_frames, n_columns); "
+            f"got {values.dtype} of shape {values.shape}",
+        )
+    values = values.astype(float)
+    if values.ndim == 3:
+        return values
+    n_joints = len(names) if names is not None else None
+    n_values = len(columns) if columns is not None else None
+    if per_line is None:
+        per_line = "joint" if n_joints and n_joints > 1 and values.shape[1] <= 4 else "frame"
+    if per_line == "joint":
+        if n_joints is None:
+            raise ValueError(f"{path}: one joint per line needs layout= to know the joint count.")
+        if len(values) % n_joints:
+            raise MotionFileError(
+                path, None, f"{len(values)} joint lines are not whole frames of {n_joints} joints"
+            )
+        return values.reshape(-1, n_joints, values.shape[1])
+    if n_joints is None and n_values is None:
+        raise ValueError(
+            f"{path}: {values.shape[1]} values per frame; give layout= (the joints) or columns= "
+            "(the values per joint) to split them."
+        )
+    n_values = n_values or values.shape[1] // n_joints
+    if values.shape[1] % n_values or (n_joints and values.shape[1] != n_joints * n_values):
+        raise MotionFileError(
+            path, None, f"{values.shape[1]} values per frame do not split into the joints"
+        )
+    return values.reshape(len(values), -1, n_values)
+
+
+def read_keypoints(
+    path,
+    layout=None,
+    *,
+    frame_rate,
+    columns=None,
+    min_confidence=None,
+    units=None,
+    per_line=None,
+):
+    """Read joint positions per frame (a tracker's or pose estimator's output) as a :class:`Motion`.
+
+    Four kinds of file:
+
+    - ``.npy``: an array ``(n_frames, n_joints, n_values)`` or
+      ``(n_frames, n_joints * n_values)``;
+    - ``.npz``: the array ``keypoints`` (or the file's only array), and
+      optionally ``confidence`` ``(n_frames, n_joints)`` and ``joint_names``;
+    - ``.csv``: one frame per row, joint after joint; an optional header
+      row names the columns ``<joint>_x, <joint>_y, ...``;
+    - ``.txt`` (and any other text): numbers separated by spaces or commas,
+      one frame per line, or one joint per line (``x y z [confidence]``, the
+      frames one after another, as Kinect recorders write them). ``#``
+      starts a comment; a missing value is written ``nan``.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The file.
+    layout : None, str or object with ``joint_names``, default=None
+        The joints in file order: a layout name (resolved by
+        :func:`skmotion.preprocessing.get_layout`), or any object with a
+        ``joint_names`` sequence. None takes the names from the file
+        (``.npz`` ``joint_names``, a CSV header), else ``joint0, joint1, ...``.
+    frame_rate : float
+        Frames per second (keypoint files do not record it).
+    columns : {"xy", "xyz", "xyc", "xyzc"}, default=None
+        The values of each joint; ``c`` is a confidence. None: 2 values are
+        ``xy``, 3 ``xyz`` and 4 ``xyzc`` (give ``"xyc"`` for 2-D keypoints
+        with a confidence, as COCO and OpenPose write them).
+    min_confidence : float, default=None
+        Positions whose confidence is below this become NaN (missing); the
+        confidences themselves are kept unchanged in
+        ``motion.extras["confidence"]``. None keeps every position.
+    units : str, default=None
+        The length unit of the positions (``"m"``, ``"mm"``, ``"px"`` ...),
+        recorded on the motion; None is ``"unknown"``. Nothing is converted.
+    per_line : {"frame", "joint"}, default=None
+        What one line (or row) of a text or 2-D array holds; None: one joint
+        when a line has at most 4 values and the layout has several joints,
+        else one frame.
+
+    Returns
+    -------
+    motion : Motion
+        A position motion (``skeleton=None``) whose ``marker_names`` are the
+        joints and whose channels are ``<joint>_x``, ``_y`` [, ``_z``];
+        ``motion.extras["confidence"]`` when the file has confidences.
+
+    Raises
+    ------
+    MotionFileError
+        A value that is not a number, a line with the wrong number of
+        values, joint lines that are not whole frames, a header that
+        disagrees with the layout; the message names the file and line.
+
+    Examples
+    --------
+    A Kinect-style text file, one joint per line (``x y z confidence``),
+    two frames of a three-joint layout:
+
+    >>> import os, tempfile
+    >>> from types import SimpleNamespace
+    >>> from skmotion.io import read_keypoints
+    >>> layout = SimpleNamespace(joint_names=["hip", "knee", "ankle"])
+    >>> text = "0 1 2 1\\n0 0.5 2 1\\n0 0 2 0.2\\n0.1 1 2 1\\n0.1 0.5 2 1\\n0.1 0 2 1\\n"
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     path = os.path.join(folder, "take.txt")
+    ...     _ = open(path, "w").write(text)
+    ...     motion = read_keypoints(path, layout, frame_rate=30, min_confidence=0.5, units="m")
+    >>> motion.channel_names[:4]
+    ['hip_x', 'hip_y', 'hip_z', 'knee_x']
+    >>> motion.channels[:, 6:9]  # the ankle, below the threshold in the first frame
+    array([[nan, nan, nan],
+           [0.1, 0. , 2. ]])
+    >>> motion.extras["confidence"][:, 2]
+    array([0.2, 1. ])
+    """
+    path = Path(path)
+    if columns is not None and columns not in _COLUMNS:
+        raise ValueError(f"columns must be None or one of {_COLUMNS}; got {columns!r}.")
+    if per_line not in (None, "frame", "joint"):
+        raise ValueError(f"per_line must be None, 'frame' or 'joint'; got {per_line!r}.")
+    names = _joint_names(layout)
+    confidence = header = None
+    if path.suffix.lower() in (".npy", ".npz"):
+        values, file_names, confidence = _read_array(path)
+    else:
+        values, header = _read_text(path)
+        file_names = None
+        if header is not None:
+            n_values = len(columns) if columns else None
+            if n_values is None:
+                n_values = len(header) // len(names) if names else None
+            if n_values is None:
+                raise ValueError(f"{path}: give layout= or columns= to split the header.")
+            file_names = _joints_from_header(path, header, n_values)
+    if names is not None and file_names is not None and list(file_names) != names:
+        raise MotionFileError(
+            path, 1 if header else None, f"joints {list(file_names)[:6]}... are not the layout's"
+        )
+    frames = _as_frames(path, values, names or file_names, columns, per_line)
+    n_frames, n_joints, n_values = frames.shape
+    columns = columns or _DEFAULT_COLUMNS.get(n_values)
+    if columns is None or len(columns) != n_values:
+        raise MotionFileError(
+            path, None, f"{n_values} values per joint; columns={columns!r} does not describe them"
+        )
+    names = names or file_names or [f"joint{k}" for k in range(n_joints)]
+    if len(names) != n_joints:
+        raise MotionFileError(path, None, f"{n_joints} joints, but the layout names {len(names)}")
+    positions = frames[:, :, [k for k, c in enumerate(columns) if c != "c"]]
+    if "c" in columns:
+        confidence = frames[:, :, columns.index("c")]
+    if confidence is not None:
+        confidence = np.asarray(confidence, dtype=float)
+        if confidence.shape != (n_frames, n_joints):
+            raise MotionFileError(
+                path, None, f"confidence of shape {confidence.shape}, not {(n_frames, n_joints)}"
+            )
+        if min_confidence is not None:
+            positions = np.where((confidence < min_confidence)[:, :, None], np.nan, positions)
+    elif min_confidence is not None:
+        raise ValueError(f"{path}: min_confidence is given but the file has no confidences.")
+    return Motion(
+        None,
+        positions.reshape(n_frames, -1),
+        frame_rate=frame_rate,
+        source=str(path),
+        marker_names=names,
+        units=units,
+        extras={} if confidence is None else {"confidence": confidence},
+    )
