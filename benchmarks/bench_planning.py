@@ -38,7 +38,7 @@ def _cmu_walks():
         SHARED_DATA / "cmu-asfamc", SHARED_DATA / "cmu-index.csv", subjects=[2, 3]
     )
     motions = [m for m, d in zip(asf.motions, asf.description) if "walk" in str(d).lower()]
-    bvh = load_bvh_folder(SHARED_DATA / "cmu-bvh" / "07")
+    bvh = load_bvh_folder(SHARED_DATA / "cmu-bvh" / "07", channel_layouts="any")
     motions += list(bvh.motions)
     return [_at_rate(m) for m in motions]
 

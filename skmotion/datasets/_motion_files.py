@@ -1,4 +1,4 @@
-"""Loading folders of motion files: CMU ASF/AMC subjects, BVH files, or both."""
+"""Loading folders of motion files: the formats of ``skmotion.io.FORMATS`` that folders hold."""
 
 import re
 from pathlib import Path
@@ -7,7 +7,8 @@ import numpy as np
 import pandas as pd
 from sklearn.utils import Bunch
 
-from skmotion.io import read_amc, read_asf, read_bvh
+from skmotion.io import FORMATS, file_format, folder_suffixes
+from skmotion.utils import progress
 
 __all__ = ["load_bvh_folder", "load_cmu_asfamc", "load_motion_folder", "read_cmu_index"]
 
@@ -86,37 +87,80 @@ def _short_label(description):
     return re.split(r",| - |;", description.strip().lower(), maxsplit=1)[0].strip()
 
 
-def _read_amc_folder(folder, index):
-    """Every (motion, amc path) of one subject folder: one ASF and its AMC trials."""
-    folder = Path(folder)
+def _skeleton_for(path, suffix):
+    """The skeleton file of a motion stored apart: ``NN<suffix>``, or the folder's only one."""
+    folder = path.parent
+    subject = path.stem.split("_")[0]
+    candidate = folder / f"{subject}{suffix}"
+    if candidate.is_file():
+        return candidate
+    candidates = sorted(folder.glob(f"*{suffix}"))
+    if len(candidates) != 1:
+        raise FileNotFoundError(
+            f"No skeleton for {path}: expected {candidate.name} or a single {suffix} file in "
+            f"{folder}."
+        )
+    return candidates[0]
+
+
+def _find_files(folder, suffixes):
+    """(format row, path) of every file below ``folder`` with one of ``suffixes``, table order."""
+    order = {row.suffix: k for k, row in enumerate(FORMATS)}
+    paths = [p for p in folder.rglob("*") if p.suffix.lower() in suffixes and p.is_file()]
+    paths.sort(key=lambda p: (order[p.suffix.lower()], p))
+    return [(file_format(p), p) for p in paths]
+
+
+def _read_files(files, index, options, verbose):
+    """Every (motion, path) of ``files``; a skeleton file is read once for all its motions."""
     skeletons = {}
     out = []
-    for amc in sorted(folder.glob("*.amc")):
-        subject = amc.stem.split("_")[0]
-        asf = folder / f"{subject}.asf"
-        if not asf.is_file():
-            candidates = sorted(folder.glob("*.asf"))
-            if len(candidates) != 1:
-                raise FileNotFoundError(
-                    f"No skeleton for {amc}: expected {asf.name} or a single .asf file in {folder}."
-                )
-            asf = candidates[0]
-        if asf not in skeletons:
-            skeletons[asf] = read_asf(asf)
-        trial = _trial_id(amc.stem)
-        rate = 120.0
+    for row, path in progress(files, verbose=verbose, desc="reading motion files"):
+        if row.skeleton_suffix is None:
+            out.append((row.reader(path, **options.get(row.suffix, {})), path))
+            continue
+        skeleton_path = _skeleton_for(path, row.skeleton_suffix)
+        if skeleton_path not in skeletons:
+            skeletons[skeleton_path] = file_format(skeleton_path).reader(skeleton_path)
+        trial = _trial_id(path.stem)
+        rate = 120.0  # CMU's rate; AMC files do not record theirs
         if (
             index is not None
             and trial in index.index
             and np.isfinite(index.loc[trial, "frame_rate"])
         ):
             rate = float(index.loc[trial, "frame_rate"])
-        out.append((read_amc(amc, skeletons[asf], frame_rate=rate), amc))
+        out.append((row.reader(path, skeletons[skeleton_path], frame_rate=rate), path))
     return out
 
 
-def _bunch(entries, root, index, descr):
+def _check_layouts(entries, folder, channel_layouts):
+    """Per clip, the index of its channel layout; refuses mixed layouts unless allowed."""
+    names = [tuple(m.channel_names) for m, _ in entries]
+    layouts = list(dict.fromkeys(names))
+    layout = np.array([layouts.index(n) for n in names], dtype=int)
+    if len(layouts) > 1 and channel_layouts == "same":
+        groups = []
+        for k, channels in enumerate(layouts):
+            paths = [p.name for (_, p), j in zip(entries, layout) if j == k]
+            shown = ", ".join(paths[:3]) + (
+                f", ... ({len(paths) - 3} more)" if len(paths) > 3 else ""
+            )
+            groups.append(
+                f"{len(channels)} channels ({channels[0]}, ...) in {len(paths)} files: {shown}"
+            )
+        raise ValueError(
+            f"The files under {folder} have {len(layouts)} different channel layouts, whose clips "
+            "do not share features:\n  " + "\n  ".join(groups) + "\nLoad them separately, or "
+            "pass channel_layouts='any' (each motion keeps its own skeleton; "
+            "VirtualMarkerTransform maps different skeletons onto shared markers)."
+        )
+    return layout, layouts
+
+
+def _bunch(entries, root, index, descr, channel_layouts="any"):
     """The Bunch of a list of (motion, path)."""
+    layout, layouts = _check_layouts(entries, root, channel_layouts)
     motions = [m for m, _ in entries]
     paths = [p for _, p in entries]
     trials = [_trial_id(p.stem) for p in paths]
@@ -142,8 +186,15 @@ def _bunch(entries, root, index, descr):
         description=np.asarray(descriptions, dtype=object),
         filenames=np.asarray([str(p) for p in paths], dtype=object),
         frame_rate=rates.pop() if len(rates) == 1 else None,
+        layout=layout,
+        layout_channels=tuple(layouts),
         DESCR=descr,
     )
+
+
+def _check_choice(channel_layouts):
+    if channel_layouts not in ("same", "any"):
+        raise ValueError(f"channel_layouts must be 'same' or 'any'; got {channel_layouts!r}.")
 
 
 def _check_folder(folder):
@@ -170,10 +221,14 @@ _BUNCH_DOC = """
         trials, description, filenames : ndarray of str
             CMU trial id (or ""), description from the index (or ""), file.
         frame_rate : float or None
-            The clips' frame rate when they share one, else None."""
+            The clips' frame rate when they share one, else None.
+        layout : ndarray of int
+            Per clip, its channel layout: an index into ``layout_channels``,
+            the distinct tuples of channel names (one when every clip has the
+            same channels)."""
 
 
-def load_cmu_asfamc(folder, index=None, *, subjects=None):
+def load_cmu_asfamc(folder, index=None, *, subjects=None, verbose=0):
     """Load CMU-style Acclaim data: one folder per subject with ``NN.asf`` and ``NN_TT.amc``.
 
     Parameters
@@ -186,6 +241,8 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None):
         rates; without it every trial is taken at 120 Hz.
     subjects : list of int, default=None
         Only these subjects.
+    verbose : int, default=0
+        Report progress over the files on standard error when >= 1.
 
     Returns
     -------
@@ -195,18 +252,19 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None):
     Examples
     --------
     >>> from skmotion.datasets import load_cmu_asfamc
-    >>> data = load_cmu_asfamc("../shared/data/cmu-asfamc", "../shared/data/cmu-index.csv")  # doctest: +SKIP
+    >>> shared = "../shared/data/"
+    >>> data = load_cmu_asfamc(shared + "cmu-asfamc", shared + "cmu-index.csv")  # doctest: +SKIP
     >>> data.description[data.trials == "02_03"]  # doctest: +SKIP
     array(['run/jog'], dtype=object)
     """
     folder = _check_folder(folder)
     index = _as_index(index)
     wanted = None if subjects is None else {int(s) for s in np.atleast_1d(subjects)}
-    entries = []
+    files = []
     for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
-        if wanted is not None and not (sub.name.isdigit() and int(sub.name) in wanted):
-            continue
-        entries += _read_amc_folder(sub, index)
+        if wanted is None or (sub.name.isdigit() and int(sub.name) in wanted):
+            files += _find_files(sub, (".amc",))
+    entries = _read_files(files, index, {}, verbose)
     if not entries:
         raise FileNotFoundError(f"No .amc trials under {folder} (expected one folder per subject).")
     return _bunch(
@@ -214,7 +272,7 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None):
     )
 
 
-def load_bvh_folder(folder, *, up_axis=None):
+def load_bvh_folder(folder, *, up_axis=None, channel_layouts="same", verbose=0):
     """Load every ``.bvh`` file under a folder (recursively), labelled by subfolder.
 
     Parameters
@@ -223,6 +281,12 @@ def load_bvh_folder(folder, *, up_axis=None):
         The folder; ``folder/walk/a.bvh`` gets the label ``"walk"``.
     up_axis : {"x", "y", "z"}, default=None
         Passed to :func:`skmotion.io.read_bvh` (None: detected per file).
+    channel_layouts : {"same", "any"}, default="same"
+        ``"same"`` refuses files whose channels differ (say 306 and 303
+        channels), naming the files of each layout; ``"any"`` loads them all
+        (``layout`` tells each clip's).
+    verbose : int, default=0
+        Report progress over the files on standard error when >= 1.
 
     Returns
     -------
@@ -246,14 +310,20 @@ def load_bvh_folder(folder, *, up_axis=None):
     (['walk', 'wave'], [0, 0, 1, 1], 30.0)
     """
     folder = _check_folder(folder)
-    entries = [(read_bvh(p, up_axis=up_axis), p) for p in sorted(folder.rglob("*.bvh"))]
-    if not entries:
+    _check_choice(channel_layouts)
+    files = _find_files(folder, (".bvh",))
+    if not files:
         raise FileNotFoundError(f"No .bvh files under {folder}.")
-    return _bunch(entries, folder, None, f"BVH files under {folder}.")
+    entries = _read_files(files, None, {".bvh": {"up_axis": up_axis}}, verbose)
+    return _bunch(entries, folder, None, f"BVH files under {folder}.", channel_layouts)
 
 
-def load_motion_folder(folder, index=None):
-    """Load every motion file under a folder: BVH files and ASF/AMC subject folders.
+def load_motion_folder(folder, index=None, *, channel_layouts="any", verbose=0):
+    """Load every motion file under a folder: BVH, ASF/AMC subject folders and C3D files.
+
+    The formats are the rows of :data:`skmotion.io.FORMATS` marked
+    ``in_folders`` (:func:`skmotion.io.folder_suffixes`); suffixes match in
+    any case. Reading ``.c3d`` files needs the ``c3d`` extra.
 
     Parameters
     ----------
@@ -263,6 +333,13 @@ def load_motion_folder(folder, index=None):
     index : str, path-like or DataFrame, default=None
         A CMU index CSV; by default one at the top of ``folder`` is used when
         present. Trials it knows are labelled by their description.
+    channel_layouts : {"any", "same"}, default="any"
+        ``"any"`` loads files of different skeletons and formats together
+        (``layout`` tells each clip's channel layout; map them onto shared
+        virtual markers with VirtualMarkerTransform); ``"same"`` refuses
+        them, naming the files of each layout.
+    verbose : int, default=0
+        Report progress over the files on standard error when >= 1.
 
     Returns
     -------
@@ -279,12 +356,13 @@ def load_motion_folder(folder, index=None):
     if index is None:
         index = _find_index(folder)
     index = _as_index(index)
-    entries = [(read_bvh(p), p) for p in sorted(folder.rglob("*.bvh"))]
-    for sub in sorted({p.parent for p in folder.rglob("*.amc")}):
-        entries += _read_amc_folder(sub, index)
-    if not entries:
-        raise FileNotFoundError(f"No .bvh or .amc files under {folder}.")
-    return _bunch(entries, folder, index, f"Motion files under {folder}.")
+    _check_choice(channel_layouts)
+    suffixes = folder_suffixes()
+    files = _find_files(folder, suffixes)
+    if not files:
+        raise FileNotFoundError(f"No motion files ({', '.join(suffixes)}) under {folder}.")
+    entries = _read_files(files, index, {}, verbose)
+    return _bunch(entries, folder, index, f"Motion files under {folder}.", channel_layouts)
 
 
 for _func in (load_cmu_asfamc, load_bvh_folder, load_motion_folder):

@@ -181,5 +181,10 @@ def test_shared_data_loaders(shared_data):
     data = load_cmu_asfamc(shared_data / "cmu-asfamc", shared_data / "cmu-index.csv", subjects=[2])
     assert len(data.clips) == 10 and data.frame_rate == 120.0
     assert data.description[data.trials == "02_03"].tolist() == ["run/jog"]
-    bvh = load_bvh_folder(shared_data / "cmu-bvh")
+    # 07_01.bvh has another skeleton (306 channels) than 07_02-12 (303): refused, then allowed.
+    with pytest.raises(ValueError, match=r"306 channels .* 1 files: 07_01.bvh\n  303 channels"):
+        load_bvh_folder(shared_data / "cmu-bvh")
+    bvh = load_bvh_folder(shared_data / "cmu-bvh", channel_layouts="any")
+    assert bvh.layout.tolist() == [0] + [1] * 11
+    assert [len(c) for c in bvh.layout_channels] == [306, 303]
     assert len(bvh.clips) == 12 and bvh.frame_rate == 60.0 and bvh.target_names.tolist() == ["07"]
