@@ -62,7 +62,9 @@ def _decode_points(raw, processor, scale, n_points):
             words = raw.reshape(-1).view(float_type)
         words = words.reshape(n_frames, n_points, 4).astype(np.float64)
         xyz = words[:, :, :3]
-        last = np.nan_to_num(words[:, :, 3], nan=-1.0).astype(np.int32)
+        # A junk fourth word (NaN, huge) counts as invalid rather than overflowing the cast.
+        last = np.clip(np.nan_to_num(words[:, :, 3], nan=-1.0), -(2**31), 2**31 - 1)
+        last = last.astype(np.int32)
     else:
         words = raw.reshape(-1).view(int_type).reshape(n_frames, n_points, 4)
         xyz = words[:, :, :3] * abs(scale)
@@ -74,11 +76,12 @@ def _decode_points(raw, processor, scale, n_points):
 
 def _point_block(path, reader):
     """The point words of every frame, as uint8 rows; analog samples are skipped."""
-    n_points = reader.point_used
+    # The package gives numpy uint16 counts: Python ints, so that the products cannot wrap.
+    n_points = int(reader.point_used)
     word = 4 if reader.point_scale < 0 else 2
     point_bytes = 4 * n_points * word
-    analog_bytes = reader.analog_used * reader.analog_per_frame * word
-    n_frames = reader.frame_count
+    analog_bytes = int(reader.analog_used) * int(reader.analog_per_frame) * word
+    n_frames = int(reader.frame_count)
     start = (int(reader.header.data_block) - 1) * 512
     data = np.fromfile(path, dtype=np.uint8, offset=start)
     frame_bytes = point_bytes + analog_bytes
@@ -97,8 +100,6 @@ def _unit_scale(path, file_unit, units):
     """The factor from the file's length unit to ``units`` (None: keep the file's)."""
     if units is None:
         return 1.0, file_unit or "unknown"
-    if units not in METERS_PER_UNIT:
-        raise ValueError(f"units must be None or one of {sorted(METERS_PER_UNIT)}; got {units!r}.")
     if file_unit not in METERS_PER_UNIT:
         raise MotionFileError(
             path,
@@ -174,6 +175,8 @@ def read_c3d(path, *, units="m"):
     """
     c3d = _import_c3d()
     path = Path(path)
+    if units is not None and units not in METERS_PER_UNIT:
+        raise ValueError(f"units must be None or one of {sorted(METERS_PER_UNIT)}; got {units!r}.")
     try:
         with open(path, "rb") as handle, warnings.catch_warnings():
             # The package warns about files without analog data; the points are what we read.
