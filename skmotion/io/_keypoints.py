@@ -75,7 +75,7 @@ def _read_text(path):
     header = None
     if not all(_is_number(w) for w in words) and not any(_is_number(w) for w in words):
         header, first = words, first + 1
-    n_values = len(words) if header else None
+    n_values = len(words)  # every line has as many values as the first
     try:
         values = np.loadtxt(
             io.StringIO("\n".join(lines[first:])),
@@ -88,8 +88,8 @@ def _read_text(path):
         raise _find_bad_line(path, lines, delimiter, first, n_values) from None
     if values.size == 0:
         raise MotionFileError(path, None, "no data lines")
-    if (header and values.shape[1] != len(header)) or np.isinf(values).any():
-        raise _find_bad_line(path, lines, delimiter, first, n_values or values.shape[1])
+    if values.shape[1] != n_values or np.isinf(values).any():
+        raise _find_bad_line(path, lines, delimiter, first, n_values)
     return values, header
 
 
