@@ -60,11 +60,11 @@ def _decode_points(raw, processor, scale, n_points):
             words = DEC_to_IEEE_BYTES(raw.tobytes())
         else:
             words = raw.reshape(-1).view(float_type)
-        words = words.reshape(n_frames, n_points, 4).astype(np.float64)
-        xyz = words[:, :, :3]
+        words = words.reshape(n_frames, n_points, 4)
+        xyz = words[:, :, :3].astype(np.float64)
         # A junk fourth word (NaN, huge) counts as invalid rather than overflowing the cast.
-        last = np.clip(np.nan_to_num(words[:, :, 3], nan=-1.0), -(2**31), 2**31 - 1)
-        last = last.astype(np.int32)
+        fourth = words[:, :, 3]
+        last = np.where(np.abs(fourth) < 2.0**31, fourth, -1.0).astype(np.int32)
     else:
         words = raw.reshape(-1).view(int_type).reshape(n_frames, n_points, 4)
         xyz = words[:, :, :3] * abs(scale)
@@ -202,7 +202,8 @@ def read_c3d(path, *, units="m"):
         raise MotionFileError(path, None, "no 3-D points (POINT:USED is 0)")
     xyz, residuals, invalid = _decode_points(block, processor, scale, n_points)
     factor, units = _unit_scale(path, file_unit, units)
-    xyz = xyz * factor
+    if factor != 1.0:
+        xyz *= factor
     xyz[invalid] = np.nan
     residuals = np.where(invalid, np.nan, residuals * factor)
     return Motion(
