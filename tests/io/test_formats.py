@@ -2,6 +2,7 @@
 
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -115,3 +116,10 @@ def test_a_position_motion_is_marker_input_for_virtual_markers(rng):
         io.Motion(None, clips[0], frame_rate=30.0)
     with pytest.raises(ValueError, match=r"extras\['r'\] must have"):
         io.Motion(None, clips[0], frame_rate=30.0, marker_names=names, extras={"r": [1]})
+
+
+def test_the_user_guide_lists_every_format():
+    text = (Path(__file__).resolve().parents[2] / "docs" / "motion-files.md").read_text()
+    table = text.split("| suffix | format |")[1].split("\n\n")[0]
+    for row in FORMATS:
+        assert f"`{row.suffix}`" in table, row.suffix
