@@ -51,7 +51,7 @@ LOADER_CASES = [
         None,
         load_motion_folder,
         FileNotFoundError,
-        r"No \.bvh or \.amc files under",
+        r"No motion files \(\.bvh, \.amc, \.c3d\) under",
     ),
     (
         "uea: unknown name",
