@@ -123,3 +123,15 @@ def test_the_user_guide_lists_every_format():
     table = text.split("| suffix | format |")[1].split("\n\n")[0]
     for row in FORMATS:
         assert f"`{row.suffix}`" in table, row.suffix
+
+
+def test_folder_loading_reports_progress_when_verbose(tmp_path, capsys):
+    from skmotion.datasets import load_bvh_folder
+
+    data = make_motions(n_clips_per_class=2, classes=["wave"], duration=(0.5, 0.5), random_state=0)
+    for k, motion in enumerate(as_motions(data.clips, data.skeletons, 30.0)):
+        write_bvh(motion, tmp_path / f"{k}.BVH")
+    assert len(load_bvh_folder(tmp_path).clips) == 2  # any case of the suffix
+    assert capsys.readouterr().err == ""
+    load_bvh_folder(tmp_path, verbose=1)
+    assert "reading motion files" in capsys.readouterr().err
