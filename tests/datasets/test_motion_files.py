@@ -1,4 +1,4 @@
-"""Loaders of motion-file folders and the CMU fetcher (cache path and offline error, never the network)."""
+"""Loaders of motion-file folders and the CMU fetcher (cache path, offline error; no network)."""
 
 import io
 import shutil
@@ -110,7 +110,7 @@ def test_load_motion_folder_mixes_formats_and_finds_the_index(tmp_path, rng):
     assert len({m.skeleton.n_channels for m in loaded.motions}) == 2
 
 
-# -- fetch_cmu_mocap: a fake server ------------------------------------------------------------------
+# -- fetch_cmu_mocap: a fake server ----------------------------------------------------------------
 
 
 class FakeServer:
