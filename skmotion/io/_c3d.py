@@ -177,21 +177,22 @@ def read_c3d(path, *, units="m"):
     path = Path(path)
     if units is not None and units not in METERS_PER_UNIT:
         raise ValueError(f"units must be None or one of {sorted(METERS_PER_UNIT)}; got {units!r}.")
-    try:
-        with open(path, "rb") as handle, warnings.catch_warnings():
-            # The package warns about files without analog data; the points are what we read.
-            warnings.simplefilter("ignore")
-            reader = c3d.Reader(handle)
-            n_points, scale = int(reader.point_used), float(reader.point_scale)
-            processor, rate = reader.proc_type, float(reader.point_rate)
-            labels = _labels(reader, n_points)
-            unit = reader.get("POINT:UNITS")
-            file_unit = unit.string_value.strip().lower() if unit is not None else ""
-            block = _point_block(path, reader)
-    except (OSError, MotionFileError):
-        raise
-    except Exception as exc:  # the package raises ValueError, struct.error, IndexError ...
-        raise MotionFileError(path, None, f"not a readable C3D file ({exc})") from None
+    with open(path, "rb") as handle:  # a missing file: the OSError names it
+        try:
+            with warnings.catch_warnings():
+                # The package warns about files without analog data; the points are what we read.
+                warnings.simplefilter("ignore")
+                reader = c3d.Reader(handle)
+                n_points, scale = int(reader.point_used), float(reader.point_scale)
+                processor, rate = reader.proc_type, float(reader.point_rate)
+                labels = _labels(reader, n_points)
+                unit = reader.get("POINT:UNITS")
+                file_unit = unit.string_value.strip().lower() if unit is not None else ""
+                block = _point_block(path, reader)
+        except MotionFileError:
+            raise
+        except Exception as exc:  # the package raises ValueError, struct.error, EOF errors ...
+            raise MotionFileError(path, None, f"not a readable C3D file ({exc})") from None
     if processor not in _WORDS or not scale or not np.isfinite(scale):
         raise MotionFileError(
             path, None, f"processor {processor!r} and POINT:SCALE {scale!r} are not usable"

@@ -73,7 +73,7 @@ def _read_text(path):
     delimiter = "," if "," in lines[first] else None
     words = [w.strip() for w in lines[first].split("#", 1)[0].split(delimiter)]
     header = None
-    if not all(_is_number(w) for w in words) and not any(_is_number(w) for w in words):
+    if not any(_is_number(w) for w in words):  # a header names every column
         header, first = words, first + 1
     n_values = len(words)  # every line has as many values as the first
     try:
