@@ -697,3 +697,67 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             max_expansions=max_expansions,
             layer=layer,
         )
+
+    # -- a live database (skmotion.tree._partial_fit, _stream, _synthesis) -------------
+
+    def partial_fit(self, X, y, classes=None, *, split_growth=2.0, rebuild_tol=None):
+        """Add clips (of known or new classes) to the database without rebuilding it.
+
+        The first call builds the database as ``fit`` does and keeps what later
+        calls need: every node's exact moments and the (standardised) frames.
+        Later calls route the new frames down the existing splits: node counts,
+        means and covariances are merged exactly (pairwise moment updates; the
+        ``"full"`` Ledoit-Wolf estimate too, from the fourth moment), and the
+        new clips' transitions are added to the graphs. The standardisation
+        and ``reg_covar``'s absolute value stay those of the first batch. See
+        the user guide (``docs/live-database.md``).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            New clips.
+        y : array-like of shape (n_clips,)
+            Their labels; a label not in ``classes_`` adds a class.
+        classes : array-like, default=None
+            Classes to add even when no clip of them is given yet (they get
+            empty graphs).
+        split_growth : float or None, default=2.0
+            A leaf whose frame count has grown this many times since it was
+            built (or last tried) is split again by the build's rule
+            (``split``, ``min_samples_leaf``, ``min_samples_split``,
+            ``max_depth``), recursively. None never splits: then node
+            statistics equal those of the first batch's tree routed with all
+            frames, whatever the order and batching of the clips.
+        rebuild_tol : float or None, default=None
+            A split node whose mean has moved more than this many of its
+            standard deviations (``sqrt(trace(cov) / n_channels)``, taken when
+            the split was made) has its subtree rebuilt from its frames. None
+            never rebuilds.
+
+        Returns
+        -------
+        self : MotionTreeHMM
+
+        Notes
+        -----
+        A model fitted with ``fit`` keeps no frames: ``partial_fit`` then
+        recovers the moments of ``"diag"`` and ``"spherical"`` nodes from their
+        estimates (exact up to rounding) and only merges new frames in; a
+        ``"full"`` model cannot be updated (its estimate hides the fourth
+        moment) and raises. Start a growing database with ``partial_fit``.
+
+        Examples
+        --------
+        >>> from skmotion.datasets import make_motions
+        >>> from skmotion.tree import MotionTreeHMM
+        >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+        >>> X = [clip[:, 6:] for clip in data.clips]
+        >>> model = MotionTreeHMM(max_depth=4).partial_fit(X[:2], data.target[:2])
+        >>> for clip, label in zip(X[2:], data.target[2:]):
+        ...     model = model.partial_fit([clip], [label])
+        >>> int(model.tree_.count[0]) == sum(len(c) for c in X), model.score(X, data.target)
+        (True, 1.0)
+        """
+        from skmotion.tree._partial_fit import partial_fit
+
+        return partial_fit(self, X, y, classes, split_growth, rebuild_tol)
