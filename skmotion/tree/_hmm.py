@@ -761,3 +761,54 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         from skmotion.tree._partial_fit import partial_fit
 
         return partial_fit(self, X, y, classes, split_growth, rebuild_tol)
+
+    def stream(self, *, layer=None, lag=0, window=None, n_best=3):
+        """An online decoder: recognition and state estimation as frames arrive.
+
+        ``stream.update(frames)`` takes one frame or a chunk and returns the
+        current node (and its ancestors at every layer above), the node
+        ``lag`` frames back, the class posterior and decision, and the most
+        likely next nodes. These are the batch answers (``decode``,
+        ``predict_proba``, ``predict_next``) for the frames seen so far, or
+        for the last ``window`` of them, exactly: the batch beam search is not
+        causal (its beams use every frame of the clip), so the stream decodes
+        its frames again at each update. See
+        :class:`~skmotion.tree._stream.MotionStream` and the user guide
+        (``docs/live-database.md``).
+
+        Parameters
+        ----------
+        layer : int, default=None
+            The layer to estimate the state at; ``layer_`` by default.
+        lag : int, default=0
+            Also report the node this many frames back (fixed-lag smoothing).
+        window : int, default=None
+            Decode only the last ``window`` frames at each update (bounded
+            cost per update), or all frames so far (None).
+        n_best : int, default=3
+            Predicted next nodes per update.
+
+        Returns
+        -------
+        stream : MotionStream
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from skmotion.datasets import make_motions
+        >>> from skmotion.tree import MotionTreeHMM
+        >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+        >>> X = [clip[:, 6:] for clip in data.clips]
+        >>> model = MotionTreeHMM(max_depth=4).fit(X, data.target)
+        >>> stream = model.stream(lag=5)
+        >>> for frame in X[0]:
+        ...     state = stream.update(frame)
+        >>> bool(state.label == model.predict(X[:1])[0])
+        True
+        >>> bool((stream.path() == model.decode(X[:1])[0]).all())
+        True
+        """
+        from skmotion.tree._stream import MotionStream
+
+        check_is_fitted(self)
+        return MotionStream(self, layer=layer, lag=lag, window=window, n_best=n_best)
