@@ -812,3 +812,78 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
         check_is_fitted(self)
         return MotionStream(self, layer=layer, lag=lag, window=window, n_best=n_best)
+
+    def sample(
+        self,
+        n_frames,
+        *,
+        y=None,
+        random_state=None,
+        layer=None,
+        smoothness=2.0,
+        transformer=None,
+        frame_rate=None,
+    ):
+        """Generate a motion: a node sequence from a transition graph, frames from its nodes.
+
+        The first node is drawn by the graph's visit frequencies and each next
+        one by its transition probabilities (those used to recognise);
+        frames are the nodes' Gaussians, the means and the noise smoothed over
+        ``smoothness`` frames so that node changes do not jump (see
+        :mod:`skmotion.tree._synthesis`).
+
+        Parameters
+        ----------
+        n_frames : int
+        y : label, default=None
+            Sample from this class's graph (with ``graph="clip"``, from one of
+            its clips' graphs, at random); the global graph by default.
+        random_state : int, RandomState instance or None, default=None
+        layer : int, default=None
+            The layer whose nodes generate the frames; ``layer_`` by default.
+        smoothness : float, default=2.0
+            Standard deviation, in frames, of the smoothing kernel (0: none).
+        transformer : VirtualMarkerTransform, default=None
+            The fitted transform, with a skeleton, that made the training
+            clips (virtual markers): the sampled markers are turned into joint
+            angles by the planning module's inverse kinematics, in the body
+            frame (the root stays in place).
+        frame_rate : float, default=None
+            Frames per second of the motion (needed with ``transformer``).
+
+        Returns
+        -------
+        sample : Bunch
+            frames : ndarray of shape (n_frames, n_features_in_)
+            nodes : ndarray of int of shape (n_frames,)
+                Layer indices of the sampled nodes.
+            layer : int
+            motion : Motion or None
+                The joint angles, for ``write_bvh`` (with ``transformer``).
+            ik_rms : ndarray of shape (n_frames,) or None
+                RMS marker error of the inverse kinematics, data units.
+
+        Examples
+        --------
+        >>> from skmotion.datasets import make_motions
+        >>> from skmotion.tree import MotionTreeHMM
+        >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+        >>> X = [clip[:, 6:] for clip in data.clips]
+        >>> model = MotionTreeHMM(max_depth=4).fit(X, data.target)
+        >>> clip = model.sample(60, y=model.classes_[0], random_state=0)
+        >>> clip.frames.shape == (60, X[0].shape[1]), bool(model.predict([clip.frames])[0] == model.classes_[0])
+        (True, True)
+        """
+        from skmotion.tree._synthesis import sample_model
+
+        check_is_fitted(self)
+        return sample_model(
+            self,
+            n_frames,
+            y=y,
+            random_state=random_state,
+            layer=layer,
+            smoothness=smoothness,
+            transformer=transformer,
+            frame_rate=frame_rate,
+        )

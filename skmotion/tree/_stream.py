@@ -127,7 +127,7 @@ class MotionStream:
         return self._buffer[start : self.n_frames]
 
     def _decode(self, frames, graphs, n_graphs, layer, score_layers, return_paths):
-        """One clip under graphs ``0 .. n_graphs - 1``, as ``MotionTreeHMM`` decodes it (exact=False)."""
+        """One clip under graphs ``0 .. n_graphs - 1``, as ``MotionTreeHMM`` decodes it."""
         model = self.model
         return beam_decode(
             model.tree_,
