@@ -28,7 +28,13 @@ from skmotion.tree._moments import Moments
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._transitions import TransitionGraphs
 
-__all__ = ["LiveDatabase", "check_growth_params", "node_moments", "regroup_graphs"]
+__all__ = [
+    "LiveDatabase",
+    "check_growth_params",
+    "clip_counts",
+    "node_moments",
+    "regroup_graphs",
+]
 
 
 def check_growth_params(split_growth, rebuild_tol):
@@ -71,17 +77,6 @@ def node_moments(tree, frames, kind, n_nodes=None):
     return out
 
 
-def _graph_counts(graphs):
-    """Per layer the ``(n_graphs * K, K)`` counts and ``(n_graphs, K)`` visits."""
-    import scipy.sparse as sp
-
-    counts = [
-        sp.vstack([graphs.counts(layer, g) for g in range(graphs.n_graphs)], format="csr")
-        for layer in range(graphs.n_layers)
-    ]
-    return counts, [graphs.visits(layer) for layer in range(graphs.n_layers)]
-
-
 def regroup_graphs(graphs, source, added=None):
     """Graphs reordered and extended, plus the counts of new clips.
 
@@ -90,25 +85,49 @@ def regroup_graphs(graphs, source, added=None):
     graphs : TransitionGraphs
     source : ndarray of int of shape (n_new_graphs,)
         The old graph each new graph continues, or -1 for a new (empty) one.
-    added : TransitionGraphs, default=None
-        Counts to add, with ``n_new_graphs`` graphs and the same layers.
+    added : tuple of lists, default=None
+        Per layer the counts ``(n_new_graphs * K, K)`` and visits
+        ``(n_new_graphs, K)`` to add (see :func:`clip_counts`).
     """
     import scipy.sparse as sp
 
-    counts, visits = _graph_counts(graphs)
+    same = len(source) == graphs.n_graphs and (source == np.arange(graphs.n_graphs)).all()
     out_counts, out_visits = [], []
-    for c, v in zip(counts, visits):
-        k = c.shape[1]
-        padded = sp.vstack([c, sp.csr_matrix((k, k), dtype=np.int64)], format="csr")
-        src = np.where(source < 0, graphs.n_graphs, source)
-        rows = (src[:, None] * k + np.arange(k)).ravel()
-        out_counts.append(padded[rows])
-        out_visits.append(np.vstack([v, np.zeros((1, k), np.int64)])[src])
-    if added is not None:
-        new_counts, new_visits = _graph_counts(added)
-        out_counts = [a + b for a, b in zip(out_counts, new_counts)]
-        out_visits = [a + b for a, b in zip(out_visits, new_visits)]
+    for layer in range(graphs.n_layers):
+        c, v = graphs.count_matrix(layer), graphs.visits(layer)
+        if not same:
+            k = c.shape[1]
+            padded = sp.vstack([c, sp.csr_matrix((k, k), dtype=np.int64)], format="csr")
+            src = np.where(source < 0, graphs.n_graphs, source)
+            c = padded[(src[:, None] * k + np.arange(k)).ravel()]
+            v = np.vstack([v, np.zeros((1, k), np.int64)])[src]
+        if added is not None:
+            c, v = c + added[0][layer], v + added[1][layer]
+        out_counts.append(c)
+        out_visits.append(v)
     return TransitionGraphs(out_counts, out_visits, graphs.smoothing)
+
+
+def clip_counts(tree, frames, offsets, graph_of_clip, n_graphs):
+    """Per layer the transition counts and visits of clips, (as in :meth:`TransitionGraphs.count`).
+
+    Without building the graphs' tables: ``partial_fit`` only adds these counts.
+    """
+    import scipy.sparse as sp
+
+    graph_of_frame = np.repeat(graph_of_clip, np.diff(offsets))
+    step = np.ones(offsets[-1], dtype=bool)
+    step[offsets[1:] - 1] = False  # a clip's last frame has no successor
+    src = np.flatnonzero(step)
+    counts, visits = [], []
+    for labels, k in zip(tree.iter_apply(frames), tree.n_nodes):
+        rows = graph_of_frame[src] * k + labels[src]
+        data = np.ones(len(rows), dtype=np.int64)
+        counts.append(sp.csr_matrix((data, (rows, labels[src + 1])), shape=(n_graphs * k, k)))
+        visits.append(
+            np.bincount(graph_of_frame * k + labels, minlength=n_graphs * k).reshape(n_graphs, k)
+        )
+    return counts, visits
 
 
 def _layers_of(left, right, root=0):

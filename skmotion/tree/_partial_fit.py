@@ -4,7 +4,12 @@ import numpy as np
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import column_or_1d
 
-from skmotion.tree._incremental import LiveDatabase, check_growth_params, regroup_graphs
+from skmotion.tree._incremental import (
+    LiveDatabase,
+    check_growth_params,
+    clip_counts,
+    regroup_graphs,
+)
 from skmotion.tree._transitions import TransitionGraphs
 from skmotion.utils._clips import check_clips, stack_clips
 
@@ -88,12 +93,13 @@ def _regraph(est, classes, tree_changed_clips, new_clips, new_y):
         est.global_graph_ = _count(tree, clips, np.zeros(len(clips), np.intp), 1, smoothing)
         est.graphs_ = _count(tree, clips, of_clip, len(graph_classes), smoothing)
     elif len(new_clips):
+        frames, offsets = stack_clips(new_clips)
         zero = np.zeros(len(new_clips), np.intp)
         est.global_graph_ = regroup_graphs(
-            est.global_graph_, np.zeros(1, np.intp), _count(tree, new_clips, zero, 1, smoothing)
+            est.global_graph_, np.zeros(1, np.intp), clip_counts(tree, frames, offsets, zero, 1)
         )
         est.graphs_ = regroup_graphs(
-            est.graphs_, source, _count(tree, new_clips, new_graph, len(source), smoothing)
+            est.graphs_, source, clip_counts(tree, frames, offsets, new_graph, len(source))
         )
     else:
         est.graphs_ = regroup_graphs(est.graphs_, source)
