@@ -24,11 +24,12 @@ Result tables, all measured in one run:
   were sampled from, per data set (chance = 1 / n_classes).
 
 Run: ``python benchmarks/bench_live.py`` (``--quick`` for a smoke run). The UEA
-and CMU rows need ``../shared/data`` and are left out, with a message, without
-it. The machine may be shared: compare ratios within one run.
+and CMU rows need ``../shared/data`` (or ``SKMOTION_SHARED_DATA``) and are left
+out, with a message, without it. The machine may be shared: compare ratios within one run.
 """
 
 import argparse
+import os
 import sys
 import time
 from pathlib import Path
@@ -37,6 +38,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA, time_call, write_results  # noqa: E402
+
+# A worktree outside the project folder finds the data through the tests' variable.
+SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
 
 from skmotion.datasets import load_uea, make_motions  # noqa: E402
 from skmotion.tree import MotionTreeHMM  # noqa: E402
@@ -75,7 +79,7 @@ CMU_CLASSES = {
 
 
 def cmu_windows(window=30, hop=15, train_share=0.6):
-    """CMU subject 02, 30 Hz virtual markers in 1 s windows; train before 60% of each trial, test after."""
+    """CMU subject 02, 30 Hz virtual markers, 1 s windows; train before 60% of each trial."""
     from skmotion.datasets import load_cmu_asfamc
     from skmotion.preprocessing import to_markers
 

@@ -205,3 +205,20 @@ def test_after_fit_diag_merges_and_full_raises():
 def test_bad_growth_parameters(bad):
     with pytest.raises(ValueError, match=next(iter(bad))):
         MotionTreeHMM().partial_fit(CLIPS, LABELS, **bad)
+
+
+def test_a_database_grown_clip_by_clip_recognises_as_a_rebuilt_one():
+    data = make_motions(
+        n_clips_per_class=6, classes=["walk", "jog", "jump", "kick"], random_state=2
+    )
+    clips, names = [c[:, 6:] for c in data.clips], data.target_names[data.target]
+    train, test = np.flatnonzero(data.groups < 3), np.flatnonzero(data.groups == 3)
+    first = [int(train[names[train] == c][0]) for c in np.unique(names)]
+    model = MotionTreeHMM(max_depth=6).partial_fit([clips[i] for i in first], names[first])
+    for i in np.random.default_rng(0).permutation(train):
+        if i not in first:
+            model.partial_fit([clips[i]], names[i : i + 1])
+    rebuilt = MotionTreeHMM(max_depth=6).fit([clips[i] for i in train], names[train])
+    X_test, y_test = [clips[i] for i in test], names[test]
+    assert model.score(X_test, y_test) >= rebuilt.score(X_test, y_test) - 0.05
+    assert model.tree_.count[0] == sum(len(clips[i]) for i in train)
