@@ -23,6 +23,7 @@ import numpy as np
 from sklearn.utils import Bunch
 
 from skmotion.tree._decode import beam_decode
+from skmotion.tree._transitions import TransitionGraphs
 
 __all__ = ["MotionStream"]
 
@@ -53,6 +54,20 @@ def _check_int(name, value, low, allow_none=False):
             f"{name} must be an int >= {low}{' or None' if allow_none else ''}; got {value!r}."
         )
     return int(value)
+
+
+def _side_by_side(graphs, other):
+    """One TransitionGraphs holding ``graphs``' graphs, then ``other``'s."""
+    import scipy.sparse as sp
+
+    counts = [
+        sp.vstack([graphs.count_matrix(layer), other.count_matrix(layer)], format="csr")
+        for layer in range(graphs.n_layers)
+    ]
+    visits = [
+        np.vstack([graphs.visits(layer), other.visits(layer)]) for layer in range(graphs.n_layers)
+    ]
+    return TransitionGraphs(counts, visits, graphs.smoothing)
 
 
 class MotionStream:
@@ -91,6 +106,12 @@ class MotionStream:
         for depth in range(self.layer, 0, -1):
             self._ancestors.insert(0, tree.parents(depth)[self._ancestors[0]])
         self._guide = model.global_graph_ if model.node_prior == "layer" else None
+        # At the classifying layer one decode serves both: the class graphs and, last, the
+        # global graph, side by side (each graph's probabilities are computed alone, so
+        # they are the same doubles; a layer's scores do not depend on the layers scored).
+        self._combined = None
+        if self.layer == model.layer_:
+            self._combined = _side_by_side(model.graphs_, model.global_graph_)
         self._buffer = np.empty((64, tree.n_channels))
         self.n_frames = 0
 
@@ -156,6 +177,23 @@ class MotionStream:
             len(model.score_layers_),
             False,
         )
+        return self._class_posterior(scores)
+
+    def _scores_and_path(self, frames):
+        """Class log posterior, global paths and their scores at the stream's layer."""
+        model = self.model
+        if self._combined is None:
+            paths, scores = self._decode(frames, model.global_graph_, 1, self.layer, 1, True)
+            return self.class_log_proba(frames), paths[0], scores[0, -1]
+        n_graphs = self._combined.n_graphs
+        paths, scores = self._decode(
+            frames, self._combined, n_graphs, model.layer_, len(model.score_layers_), True
+        )
+        return self._class_posterior(scores[:-1]), paths[-1], scores[-1, -1]
+
+    def _class_posterior(self, scores):
+        """The normalised class log probabilities from each class (clip) graph's path scores."""
+        model = self.model
         per_graph = _sum_of_paths(scores).sum(axis=1)
         if model.graph == "class":
             log_prob = per_graph
@@ -196,16 +234,16 @@ class MotionStream:
             raise ValueError("the stream has seen no frame yet; call update first.")
         model = self.model
         frames = self._frames(self.window)
-        paths, scores = self._decode(frames, model.global_graph_, 1, self.layer, 1, True)
-        best = paths[0, 0]
+        class_log_proba, paths, scores = self._scores_and_path(frames)
+        best = paths[0]
         node = int(best[-1])
-        log_w = _log_normalise(scores[0, -1])
+        log_w = _log_normalise(scores)
         current = np.zeros(int(model.tree_.n_nodes[self.layer]))
-        valid = paths[0, :, -1] >= 0
-        np.add.at(current, paths[0, valid, -1], np.exp(log_w[valid]))
+        valid = paths[:, -1] >= 0
+        np.add.at(current, paths[valid, -1], np.exp(log_w[valid]))
         future = model.global_graph_.propagate(self.layer, 0, current[None], 1)[0]
         order = np.argsort(-future, kind="stable")[: self.n_best]
-        proba = np.exp(self.class_log_proba(frames))
+        proba = np.exp(class_log_proba)
         return Bunch(
             frame=self.n_frames - 1,
             node=node,

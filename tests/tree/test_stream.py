@@ -114,3 +114,16 @@ def test_bad_frames_and_parameters():
     for kwargs in ({"lag": -1}, {"window": 0}, {"n_best": 0}):
         with pytest.raises(ValueError, match=next(iter(kwargs))):
             model.stream(**kwargs)
+
+
+@pytest.mark.parametrize("name", ["class", "clip, graph prior"])
+def test_an_upper_layer_streams_its_own_decode(name):
+    model, clip = MODELS[name], CLIPS[7]
+    stream = model.stream(layer=2, lag=4)
+    for t in range(0, len(clip), 9):
+        state = stream.update(clip[t : t + 9])
+        prefix = [clip[: t + 9]]
+        path = model.decode(prefix, layer=2)[0]
+        assert state.node == path[-1] and state.lagged_node == path[-5]
+        np.testing.assert_array_equal(state.proba, model.predict_proba(prefix)[0])
+    np.testing.assert_array_equal(stream.path(), model.decode([clip], layer=2)[0])
