@@ -222,3 +222,15 @@ def test_a_database_grown_clip_by_clip_recognises_as_a_rebuilt_one():
     X_test, y_test = [clips[i] for i in test], names[test]
     assert model.score(X_test, y_test) >= rebuilt.score(X_test, y_test) - 0.05
     assert model.tree_.count[0] == sum(len(clips[i]) for i in train)
+
+
+def test_a_pickled_database_keeps_growing_the_same():
+    import pickle
+
+    model = MotionTreeHMM(max_depth=4, min_samples_leaf=8).partial_fit(CLIPS[:6], LABELS[:6])
+    copy = pickle.loads(pickle.dumps(model))
+    for m in (model, copy):
+        m.partial_fit(CLIPS[6:], LABELS[6:], split_growth=1.5)
+    np.testing.assert_array_equal(copy.tree_.count, model.tree_.count)
+    np.testing.assert_array_equal(copy.tree_.covariance, model.tree_.covariance)
+    np.testing.assert_array_equal(copy.predict_proba(CLIPS), model.predict_proba(CLIPS))
