@@ -21,7 +21,8 @@ Result tables, all measured in one run:
   clip after which the class decision is correct and stays so (median), and
   the share of clips whose decision is correct at the end (the batch accuracy).
 - ``live_synthesis``: the share of sampled clips recognised as the class they
-  were sampled from, per data set (chance = 1 / n_classes).
+  were sampled from, per data set (chance = 1 / n_classes), for three
+  smoothing widths (0: independent frames).
 
 Run: ``python benchmarks/bench_live.py`` (``--quick`` for a smoke run). The UEA
 and CMU rows need ``../shared/data`` (or ``SKMOTION_SHARED_DATA``) and are left
@@ -293,20 +294,19 @@ def synthesis(sets):
         Xtr, ytr, _, _ = loader()
         model = MotionTreeHMM().fit(Xtr, ytr)
         length = int(np.median([len(c) for c in Xtr]))
-        hits = []
-        for label in model.classes_:
-            samples = [model.sample(length, y=label, random_state=s).frames for s in range(10)]
-            hits.append(np.mean(model.predict(samples) == label))
-        rows.append(
-            {
-                "data": name,
-                "classes": len(model.classes_),
-                "chance": 1 / len(model.classes_),
-                "sampled clips recognised as their class": float(np.mean(hits)),
-                "worst class": float(np.min(hits)),
-                "frames per sample": length,
-            }
-        )
+        row = {"data": name, "classes": len(model.classes_), "chance": 1 / len(model.classes_)}
+        for smoothness in (0.0, 1.0, 2.0):
+            hits = []
+            for label in model.classes_:
+                samples = [
+                    model.sample(length, y=label, random_state=s, smoothness=smoothness).frames
+                    for s in range(10)
+                ]
+                hits.append(np.mean(model.predict(samples) == label))
+            row[f"recognised, smoothness {smoothness:g}"] = float(np.mean(hits))
+            row[f"worst class, smoothness {smoothness:g}"] = float(np.min(hits))
+        row["frames per sample"] = length
+        rows.append(row)
     return rows
 
 

@@ -820,7 +820,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         y=None,
         random_state=None,
         layer=None,
-        smoothness=2.0,
+        smoothness=1.0,
         transformer=None,
         frame_rate=None,
     ):
@@ -841,7 +841,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         random_state : int, RandomState instance or None, default=None
         layer : int, default=None
             The layer whose nodes generate the frames; ``layer_`` by default.
-        smoothness : float, default=2.0
+        smoothness : float, default=1.0
             Standard deviation, in frames, of the smoothing kernel (0: none).
         transformer : VirtualMarkerTransform, default=None
             The fitted transform, with a skeleton, that made the training

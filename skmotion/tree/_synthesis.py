@@ -68,7 +68,7 @@ def _noise_factors(tree, ids):
     return np.sqrt(cov)
 
 
-def sample_frames(tree, layer, nodes, rng, smoothness=2.0):
+def sample_frames(tree, layer, nodes, rng, smoothness=1.0):
     """Frames (in the tree's units) for a node sequence: smoothed means plus smoothed node noise.
 
     Parameters
@@ -78,7 +78,7 @@ def sample_frames(tree, layer, nodes, rng, smoothness=2.0):
     nodes : ndarray of int of shape (n_frames,)
         Layer indices.
     rng : numpy.random.Generator
-    smoothness : float, default=2.0
+    smoothness : float, default=1.0
         Standard deviation, in frames, of the Gaussian kernel smoothing the
         means and the noise; 0 for none (independent draws, steps at node changes).
 
