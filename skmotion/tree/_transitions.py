@@ -301,5 +301,5 @@ class TransitionGraphs:
         return out
 
     def count_matrix(self, layer):
-        """All graphs' counts at a layer: one sparse ``(n_graphs * K, K)`` matrix, graph after graph."""
+        """All graphs' counts at a layer: a sparse ``(n_graphs * K, K)`` matrix, graph by graph."""
         return self._counts[layer]
