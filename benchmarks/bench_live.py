@@ -16,7 +16,8 @@ Result tables, all measured in one run:
   inside each trial, as in ``bench_tree.py``).
 - ``live_stream_cost``: microseconds per frame of ``stream().update`` on a clip
   of 32 virtual markers (192 channels), against the chunk size and the window,
-  and the ratio to the batch ``predict`` + ``decode`` of the same frames.
+  and the ratio to the batch ``predict`` + ``decode`` of the same frames (timed
+  in alternation).
 - ``live_latency``: streaming every test clip frame by frame, the share of the
   clip after which the class decision is correct and stays so (median), and
   the share of clips whose decision is correct at the end (the batch accuracy).
@@ -38,7 +39,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA, time_call, write_results  # noqa: E402
+from _common import SHARED_DATA, interleaved, time_call, write_results  # noqa: E402
 
 # A worktree outside the project folder finds the data through the tests' variable.
 SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
@@ -231,7 +232,11 @@ def stream_cost(quick):
     model, clip, source = stream_clip(quick)
     n = min(len(clip), 120 if quick else 300)
     clip = clip[:n]
-    batch = time_call(lambda: (model.predict([clip]), model.decode([clip])), repeats=5)[0]
+
+    def batch():
+        model.predict([clip])
+        model.decode([clip])
+
     rows = []
     for window in (30, None):
         for chunk in (1, 10, 30):
@@ -241,7 +246,8 @@ def stream_cost(quick):
                 for start in range(0, n, chunk):
                     stream.update(clip[start : start + chunk])
 
-            seconds = time_call(run, repeats=3)[0]
+            # in alternation with the batch calls, so both see the same load
+            seconds, batch_s = interleaved([run, batch], rounds=3)
             rows.append(
                 {
                     "data": source,
@@ -252,7 +258,8 @@ def stream_cost(quick):
                     "chunk": chunk,
                     "us per frame": 1e6 * seconds / n,
                     "us per update": 1e6 * seconds / -(-n // chunk),
-                    "batch predict+decode of the clip, us per frame": 1e6 * batch / n,
+                    "batch predict+decode, us per frame": 1e6 * batch_s / n,
+                    "stream / batch": seconds / batch_s,
                 }
             )
     return rows
