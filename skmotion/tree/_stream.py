@@ -76,7 +76,8 @@ class MotionStream:
     Parameters
     ----------
     model : MotionTreeHMM
-        A fitted model (not copied: refit it and start a new stream).
+        A fitted model, not copied: after ``fit`` or ``partial_fit`` start a new
+        stream (this one keeps the graphs it was made with).
     layer : int, default=None
         The layer to estimate the state at; the model's ``layer_`` by default.
     lag : int, default=0
