@@ -76,8 +76,8 @@ class MotionStream:
     Parameters
     ----------
     model : MotionTreeHMM
-        A fitted model, not copied: after ``fit`` or ``partial_fit`` start a new
-        stream (this one keeps the graphs it was made with).
+        A fitted model, not copied: after ``fit`` or ``partial_fit`` the
+        stream refuses to go on (start a new one).
     layer : int, default=None
         The layer to estimate the state at; the model's ``layer_`` by default.
     lag : int, default=0
@@ -97,7 +97,7 @@ class MotionStream:
 
     def __init__(self, model, *, layer=None, lag=0, window=None, n_best=3):
         self.model = model
-        tree = model.tree_
+        tree = self._tree = model.tree_
         self.layer = model.layer_ if layer is None else tree.check_layer(layer)
         self.lag = _check_int("lag", lag, 0)
         self.window = _check_int("window", window, 1, allow_none=True)
@@ -234,6 +234,11 @@ class MotionStream:
         if self.n_frames == 0:
             raise ValueError("the stream has seen no frame yet; call update first.")
         model = self.model
+        if model.tree_ is not self._tree:
+            raise ValueError(
+                "the model was fit again (fit or partial_fit) since this stream was made; "
+                "start a new stream."
+            )
         frames = self._frames(self.window)
         class_log_proba, paths, scores = self._scores_and_path(frames)
         best = paths[0]

@@ -127,3 +127,12 @@ def test_an_upper_layer_streams_its_own_decode(name):
         assert state.node == path[-1] and state.lagged_node == path[-5]
         np.testing.assert_array_equal(state.proba, model.predict_proba(prefix)[0])
     np.testing.assert_array_equal(stream.path(), model.decode([clip], layer=2)[0])
+
+
+def test_a_stream_refuses_a_model_fit_again():
+    model = MotionTreeHMM(max_depth=3, min_samples_leaf=8).partial_fit(CLIPS[:6], LABELS[:6])
+    stream = model.stream()
+    stream.update(CLIPS[0][:5])
+    model.partial_fit(CLIPS[6:], LABELS[6:])
+    with pytest.raises(ValueError, match="start a new stream"):
+        stream.update(CLIPS[0][5:10])
