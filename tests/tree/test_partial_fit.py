@@ -234,3 +234,15 @@ def test_a_pickled_database_keeps_growing_the_same():
     np.testing.assert_array_equal(copy.tree_.count, model.tree_.count)
     np.testing.assert_array_equal(copy.tree_.covariance, model.tree_.covariance)
     np.testing.assert_array_equal(copy.predict_proba(CLIPS), model.predict_proba(CLIPS))
+
+
+@pytest.mark.parametrize("graph", ["class", "clip"])
+def test_splits_and_rebuilds_keep_statistics_and_graphs_exact(graph):
+    model = MotionTreeHMM(max_depth=5, min_samples_leaf=8, graph=graph)
+    model.partial_fit(CLIPS[:2], LABELS[:2], classes=["zzz"])
+    before = model.tree_.n_tree_nodes
+    for i in range(2, len(CLIPS)):
+        model.partial_fit(CLIPS[i : i + 1], LABELS[i : i + 1], split_growth=1.5, rebuild_tol=0.5)
+    assert model.tree_.n_tree_nodes != before  # the structure changed on the way
+    assert "zzz" in model.classes_
+    check_against_one_shot(model, CLIPS, LABELS)
