@@ -110,6 +110,8 @@ def _regraph(est, classes, tree_changed_clips, new_clips, new_y):
 def partial_fit(est, X, y, classes, split_growth, rebuild_tol):
     """See :meth:`MotionTreeHMM.partial_fit`."""
     check_growth_params(split_growth, rebuild_tol)
+    if classes is not None and np.ndim(classes) != 1:
+        raise ValueError(f"classes must be a 1-D array-like of labels; got {classes!r}.")
     if not hasattr(est, "tree_"):
         return _first_call(est, X, y, classes)
     clips = check_clips(X, estimator=est)

@@ -201,7 +201,9 @@ def test_after_fit_diag_merges_and_full_raises():
         full.partial_fit(CLIPS[4:], LABELS[4:])
 
 
-@pytest.mark.parametrize("bad", [{"split_growth": 1.0}, {"rebuild_tol": 0}, {"split_growth": "x"}])
+@pytest.mark.parametrize(
+    "bad", [{"split_growth": 1.0}, {"rebuild_tol": 0}, {"split_growth": "x"}, {"classes": "dance"}]
+)
 def test_bad_growth_parameters(bad):
     with pytest.raises(ValueError, match=next(iter(bad))):
         MotionTreeHMM().partial_fit(CLIPS, LABELS, **bad)
