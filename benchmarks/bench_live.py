@@ -5,8 +5,9 @@ Result tables, all measured in one run:
 - ``live_update_cost``: seconds per ``partial_fit`` call adding one clip
   (without splits) against the tree's depth, split into a cost per added frame
   (the slope between clips of 20 and 1000 frames) and a fixed cost per call, and
-  the ratio to rebuilding the database with ``fit``; 60 joint-angle channels
-  of the synthetic motions.
+  the ratio to rebuilding the database with ``fit``; also the per-frame work
+  alone (routing, moment merges, transition counts of a 1000-frame clip); 60
+  joint-angle channels of the synthetic motions.
 - ``live_growth``: test accuracy of a database grown clip by clip
   (``partial_fit``; the first call holds one clip per class, the rest arrive
   one at a time in a shuffled order) against one rebuilt from all training
@@ -46,6 +47,7 @@ SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
 
 from skmotion.datasets import load_uea, make_motions  # noqa: E402
 from skmotion.tree import MotionTreeHMM  # noqa: E402
+from skmotion.tree._incremental import clip_counts, node_moments  # noqa: E402
 
 # -- data ------------------------------------------------------------------------------
 
@@ -167,6 +169,16 @@ def update_cost(quick):
         t_short, t_long = float(np.median(t_short)), float(np.median(t_long))
         per_frame = (t_long - t_short) / (len(long_) - len(short))
         t_fit = time_call(lambda params=params: MotionTreeHMM(**params).fit(clips, y), repeats=3)[0]
+        # the per-frame work alone: routing, the moment merges and the transition counts
+        std = (long_ - model.center_) / model.scale_
+        offsets = np.array([0, len(std)])
+
+        def per_frame_work(model=model, std=std, offsets=offsets):
+            tree = model.tree_
+            node_moments(tree, std, tree.covariance_type)
+            clip_counts(tree, std, offsets, np.zeros(1, np.intp), 1)
+
+        t_work = time_call(per_frame_work, repeats=7)[0]
         rows.append(
             {
                 "max_depth": depth,
@@ -174,6 +186,7 @@ def update_cost(quick):
                 "tree nodes": nodes,
                 "frames in database": frames,
                 "us per added frame": 1e6 * per_frame,
+                "us per frame, routing + merges alone": 1e6 * t_work / len(long_),
                 "ms per call (fixed)": 1e3 * (t_short - per_frame * len(short)),
                 "ms per 20-frame clip": 1e3 * t_short,
                 "ms per 1000-frame clip": 1e3 * t_long,
