@@ -19,6 +19,7 @@ SECTIONS = (
     "skmotion._demo.evaluation",
     "skmotion._demo.checks",
     "skmotion._demo.planning",
+    "skmotion._demo.live",
 )
 
 

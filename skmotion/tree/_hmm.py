@@ -697,3 +697,195 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             max_expansions=max_expansions,
             layer=layer,
         )
+
+    # -- a live database (skmotion.tree._partial_fit, _stream, _synthesis) -------------
+
+    def partial_fit(self, X, y, classes=None, *, split_growth=2.0, rebuild_tol=None):
+        """Add clips (of known or new classes) to the database without rebuilding it.
+
+        The first call builds the database as ``fit`` does and keeps what later
+        calls need: every node's exact moments and the (standardised) frames.
+        Later calls route the new frames down the existing splits: node counts,
+        means and covariances are merged exactly (pairwise moment updates; the
+        ``"full"`` Ledoit-Wolf estimate too, from the fourth moment), and the
+        new clips' transitions are added to the graphs. The standardisation
+        and ``reg_covar``'s absolute value stay those of the first batch. See
+        the user guide (``docs/live-database.md``).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            New clips.
+        y : array-like of shape (n_clips,)
+            Their labels; a label not in ``classes_`` adds a class.
+        classes : array-like, default=None
+            Classes to add even when no clip of them is given yet (they get
+            empty graphs).
+        split_growth : float or None, default=2.0
+            A leaf whose frame count has grown this many times since it was
+            built (or last tried) is split again by the build's rule
+            (``split``, ``min_samples_leaf``, ``min_samples_split``,
+            ``max_depth``), recursively. None never splits: then node
+            statistics equal those of the first batch's tree routed with all
+            frames, whatever the order and batching of the clips.
+        rebuild_tol : float or None, default=None
+            A split node whose mean has moved more than this many of its
+            standard deviations (``sqrt(trace(cov) / n_channels)``, taken when
+            the split was made) has its subtree rebuilt from its frames. None
+            never rebuilds.
+
+        Returns
+        -------
+        self : MotionTreeHMM
+
+        Notes
+        -----
+        A model fitted with ``fit`` keeps no frames: ``partial_fit`` then
+        recovers the moments of ``"diag"`` and ``"spherical"`` nodes from their
+        estimates (exact up to rounding) and only merges new frames in; a
+        ``"full"`` model cannot be updated (its estimate hides the fourth
+        moment) and raises. Start a growing database with ``partial_fit``.
+
+        Examples
+        --------
+        >>> from skmotion.datasets import make_motions
+        >>> from skmotion.tree import MotionTreeHMM
+        >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+        >>> X = [clip[:, 6:] for clip in data.clips]
+        >>> model = MotionTreeHMM(max_depth=4).partial_fit(X[:2], data.target[:2])
+        >>> for clip, label in zip(X[2:], data.target[2:]):
+        ...     model = model.partial_fit([clip], [label])
+        >>> int(model.tree_.count[0]) == sum(len(c) for c in X), model.score(X, data.target)
+        (True, 1.0)
+        """
+        from skmotion.tree._partial_fit import partial_fit
+
+        return partial_fit(self, X, y, classes, split_growth, rebuild_tol)
+
+    def stream(self, *, layer=None, lag=0, window=None, n_best=3):
+        """An online decoder: recognition and state estimation as frames arrive.
+
+        ``stream.update(frames)`` takes one frame or a chunk and returns the
+        current node (and its ancestors at every layer above), the node
+        ``lag`` frames back, the class posterior and decision, and the most
+        likely next nodes. These are the batch answers (``decode``,
+        ``predict_proba``, ``predict_next``) for the frames seen so far, or
+        for the last ``window`` of them, exactly: the batch beam search is not
+        causal (its beams use every frame of the clip), so the stream decodes
+        its frames again at each update. See
+        :class:`~skmotion.tree._stream.MotionStream` and the user guide
+        (``docs/live-database.md``).
+
+        Parameters
+        ----------
+        layer : int, default=None
+            The layer to estimate the state at; ``layer_`` by default.
+        lag : int, default=0
+            Also report the node this many frames back (fixed-lag smoothing).
+        window : int, default=None
+            Decode only the last ``window`` frames at each update (bounded
+            cost per update), or all frames so far (None).
+        n_best : int, default=3
+            Predicted next nodes per update.
+
+        Returns
+        -------
+        stream : MotionStream
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> from skmotion.datasets import make_motions
+        >>> from skmotion.tree import MotionTreeHMM
+        >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+        >>> X = [clip[:, 6:] for clip in data.clips]
+        >>> model = MotionTreeHMM(max_depth=4).fit(X, data.target)
+        >>> stream = model.stream(lag=5)
+        >>> for frame in X[0]:
+        ...     state = stream.update(frame)
+        >>> bool(state.label == model.predict(X[:1])[0])
+        True
+        >>> bool((stream.path() == model.decode(X[:1])[0]).all())
+        True
+        """
+        from skmotion.tree._stream import MotionStream
+
+        check_is_fitted(self)
+        return MotionStream(self, layer=layer, lag=lag, window=window, n_best=n_best)
+
+    def sample(
+        self,
+        n_frames,
+        *,
+        y=None,
+        random_state=None,
+        layer=None,
+        smoothness=1.0,
+        transformer=None,
+        frame_rate=None,
+    ):
+        """Generate a motion: a node sequence from a transition graph, frames from its nodes.
+
+        The first node is drawn by the graph's visit frequencies and each next
+        one by its transition probabilities (those used to recognise);
+        frames are the nodes' Gaussians, the means and the noise smoothed over
+        ``smoothness`` frames so that node changes do not jump (see
+        :mod:`skmotion.tree._synthesis`).
+
+        Parameters
+        ----------
+        n_frames : int
+        y : label, default=None
+            Sample from this class's graph (with ``graph="clip"``, from one of
+            its clips' graphs, at random); the global graph by default.
+        random_state : int, RandomState instance or None, default=None
+        layer : int, default=None
+            The layer whose nodes generate the frames; ``layer_`` by default.
+        smoothness : float, default=1.0
+            Standard deviation, in frames, of the smoothing kernel (0: none).
+        transformer : VirtualMarkerTransform, default=None
+            The fitted transform, with a skeleton, that made the training
+            clips (virtual markers): the sampled markers are turned into joint
+            angles by the planning module's inverse kinematics, in the body
+            frame (the root stays in place).
+        frame_rate : float, default=None
+            Frames per second of the motion (needed with ``transformer``).
+
+        Returns
+        -------
+        sample : Bunch
+            frames : ndarray of shape (n_frames, n_features_in_)
+            nodes : ndarray of int of shape (n_frames,)
+                Layer indices of the sampled nodes.
+            layer : int
+            motion : Motion or None
+                The joint angles, for ``write_bvh`` (with ``transformer``).
+            ik_rms : ndarray of shape (n_frames,) or None
+                RMS marker error of the inverse kinematics, data units.
+
+        Examples
+        --------
+        >>> from skmotion.datasets import make_motions
+        >>> from skmotion.tree import MotionTreeHMM
+        >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+        >>> X = [clip[:, 6:] for clip in data.clips]
+        >>> model = MotionTreeHMM(max_depth=4).fit(X, data.target)
+        >>> clip = model.sample(60, y=model.classes_[0], random_state=0)
+        >>> clip.frames.shape == (60, X[0].shape[1])
+        True
+        >>> bool(model.predict([clip.frames])[0] == model.classes_[0])
+        True
+        """
+        from skmotion.tree._synthesis import sample_model
+
+        check_is_fitted(self)
+        return sample_model(
+            self,
+            n_frames,
+            y=y,
+            random_state=random_state,
+            layer=layer,
+            smoothness=smoothness,
+            transformer=transformer,
+            frame_rate=frame_rate,
+        )

@@ -299,3 +299,7 @@ class TransitionGraphs:
         for _ in range(n_steps):
             out = np.asarray((counts.T @ (out * scale).T).T) + (out @ unseen)[..., None]
         return out
+
+    def count_matrix(self, layer):
+        """All graphs' counts at a layer: a sparse ``(n_graphs * K, K)`` matrix, graph by graph."""
+        return self._counts[layer]

@@ -1,0 +1,356 @@
+"""A live motion database: incremental updates, streaming recognition, synthesis.
+
+Result tables, all measured in one run:
+
+- ``live_update_cost``: seconds per ``partial_fit`` call adding one clip
+  (without splits) against the tree's depth, split into a cost per added frame
+  (the slope between clips of 20 and 1000 frames) and a fixed cost per call, and
+  the ratio to rebuilding the database with ``fit``; also the per-frame work
+  alone (routing, moment merges, transition counts of a 1000-frame clip); 60
+  joint-angle channels of the synthetic motions.
+- ``live_growth``: test accuracy of a database grown clip by clip
+  (``partial_fit``; the first call holds one clip per class, the rest arrive
+  one at a time in a shuffled order) against one rebuilt from all training
+  clips (``fit``), with the same (default) hyperparameters: BasicMotions and
+  JapaneseVowels (the archive's split), the synthetic motions (subject 3 held
+  out) and CMU subject 02 in 1 s windows of virtual markers (split by time
+  inside each trial, as in ``bench_tree.py``).
+- ``live_stream_cost``: microseconds per frame of ``stream().update`` on a clip
+  of 32 virtual markers (192 channels), against the chunk size and the window,
+  and the ratio to the batch ``predict`` + ``decode`` of the same frames (timed
+  in alternation).
+- ``live_latency``: streaming every test clip frame by frame, the share of the
+  clip after which the class decision is correct and stays so (median), and
+  the share of clips whose decision is correct at the end (the batch accuracy).
+- ``live_synthesis``: the share of sampled clips recognised as the class they
+  were sampled from, per data set (chance = 1 / n_classes), for three
+  smoothing widths (0: independent frames).
+
+Run: ``python benchmarks/bench_live.py`` (``--quick`` for a smoke run). The UEA
+and CMU rows need ``../shared/data`` (or ``SKMOTION_SHARED_DATA``) and are left
+out, with a message, without it. The machine may be shared: compare ratios within one run.
+"""
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import SHARED_DATA, interleaved, time_call, write_results  # noqa: E402
+
+# A worktree outside the project folder finds the data through the tests' variable.
+SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
+
+from skmotion.datasets import load_uea, make_motions  # noqa: E402
+from skmotion.tree import MotionTreeHMM  # noqa: E402
+from skmotion.tree._incremental import clip_counts, node_moments  # noqa: E402
+
+# -- data ------------------------------------------------------------------------------
+
+
+def uea(name):
+    train = load_uea(name, subset="train", data_home=SHARED_DATA)
+    test = load_uea(name, subset="test", data_home=SHARED_DATA)
+    return train.clips, train.target, test.clips, test.target
+
+
+def synthetic():
+    data = make_motions(random_state=0)
+    clips = [c[:, 6:] for c in data.clips]
+    names = data.target_names[data.target]
+    train = data.groups < 3
+    return (
+        [c for c, m in zip(clips, train) if m],
+        names[train],
+        [c for c, m in zip(clips, train) if not m],
+        names[~train],
+    )
+
+
+CMU_CLASSES = {
+    "walk": "walk",
+    "run/jog": "run",
+    "jump, balance": "jump",
+    "punch/strike": "punch",
+    "bend over, scoop up, rise, lift arm": "bend",
+    "swordplay": "swordplay",
+    "wash self": "wash",
+}
+
+
+def cmu_windows(window=30, hop=15, train_share=0.6):
+    """CMU subject 02, 30 Hz virtual markers, 1 s windows; train before 60% of each trial."""
+    from skmotion.datasets import load_cmu_asfamc
+    from skmotion.preprocessing import to_markers
+
+    data = load_cmu_asfamc(
+        SHARED_DATA / "cmu-asfamc", index=SHARED_DATA / "cmu-index.csv", subjects=[2]
+    )
+    markers, _ = to_markers(data.motions)
+    step = int(round(data.frame_rate / 30))
+    Xtr, ytr, Xte, yte = [], [], [], []
+    for clip, description in zip((m[::step] for m in markers), data.description):
+        cut = int(train_share * len(clip))
+        for part, X, y in ((clip[:cut], Xtr, ytr), (clip[cut:], Xte, yte)):
+            for start in range(0, len(part) - window + 1, hop):
+                X.append(part[start : start + window])
+                y.append(CMU_CLASSES[description])
+    ytr, yte = np.asarray(ytr), np.asarray(yte)
+    both = np.intersect1d(ytr, yte)
+    keep_tr, keep_te = np.isin(ytr, both), np.isin(yte, both)
+    return (
+        [x for x, k in zip(Xtr, keep_tr) if k],
+        ytr[keep_tr],
+        [x for x, k in zip(Xte, keep_te) if k],
+        yte[keep_te],
+    )
+
+
+def datasets(quick):
+    sets = {"synthetic, subject 3 held out": synthetic}
+    if quick:
+        return sets
+    if (SHARED_DATA / "uea").is_dir():
+        sets["BasicMotions"] = lambda: uea("BasicMotions")
+        sets["JapaneseVowels"] = lambda: uea("JapaneseVowels")
+    else:
+        print(f"UEA: not found in {SHARED_DATA}, left out")
+    if (SHARED_DATA / "cmu-asfamc").is_dir():
+        sets["CMU 02, 1 s windows"] = cmu_windows
+    else:
+        print(f"CMU: not found in {SHARED_DATA}, left out")
+    return sets
+
+
+# -- the studies -----------------------------------------------------------------------
+
+
+def grow(model, X, y, *, seed=0, **kwargs):
+    """partial_fit: one clip per class first, then the others one by one in a shuffled order."""
+    y = np.asarray(y)
+    first = [int(np.flatnonzero(y == c)[0]) for c in np.unique(y)]
+    rest = [i for i in np.random.default_rng(seed).permutation(len(X)) if i not in first]
+    model.partial_fit([X[i] for i in first], y[first], **kwargs)
+    for i in rest:
+        model.partial_fit([X[i]], y[i : i + 1], **kwargs)
+    return model
+
+
+def _seconds_per_call(model, clip, label, n_calls):
+    """Median seconds of ``partial_fit`` adding ``clip`` (no splits), over ``n_calls`` calls."""
+    times = []
+    for _ in range(n_calls):
+        start = time.perf_counter()
+        model.partial_fit([clip], [label], split_growth=None)
+        times.append(time.perf_counter() - start)
+    return float(np.median(times))
+
+
+def update_cost(quick):
+    data = make_motions(n_clips_per_class=4 if quick else 10, random_state=0)
+    clips, y = [c[:, 6:] for c in data.clips], data.target_names[data.target]
+    rng = np.random.default_rng(0)
+    short, long_ = (clips[0][rng.integers(0, len(clips[0]), n)] for n in (20, 1000))
+    n_calls = 5 if quick else 15
+    rows = []
+    for depth in (2, 4, 6) if quick else (2, 4, 6, 8, 10, 12):
+        params = dict(max_depth=depth, split="median", min_samples_leaf=4)
+        model = MotionTreeHMM(**params).partial_fit(clips, y)
+        nodes, frames = model.tree_.n_tree_nodes, int(model.tree_.count[0])
+        # alternate short and long clips so that both see the same load and database size
+        t_short, t_long = [], []
+        for _ in range(n_calls):
+            t_short.append(_seconds_per_call(model, short, y[0], 1))
+            t_long.append(_seconds_per_call(model, long_, y[0], 1))
+        t_short, t_long = float(np.median(t_short)), float(np.median(t_long))
+        per_frame = (t_long - t_short) / (len(long_) - len(short))
+        t_fit = time_call(lambda params=params: MotionTreeHMM(**params).fit(clips, y), repeats=3)[0]
+        # the per-frame work alone: routing, the moment merges and the transition counts
+        std = (long_ - model.center_) / model.scale_
+        offsets = np.array([0, len(std)])
+
+        def per_frame_work(model=model, std=std, offsets=offsets):
+            tree = model.tree_
+            node_moments(tree, std, tree.covariance_type)
+            clip_counts(tree, std, offsets, np.zeros(1, np.intp), 1)
+
+        t_work = time_call(per_frame_work, repeats=7)[0]
+        rows.append(
+            {
+                "max_depth": depth,
+                "layers": model.n_layers_,
+                "tree nodes": nodes,
+                "frames in database": frames,
+                "us per added frame": 1e6 * per_frame,
+                "us per frame, routing + merges alone": 1e6 * t_work / len(long_),
+                "ms per call (fixed)": 1e3 * (t_short - per_frame * len(short)),
+                "ms per 20-frame clip": 1e3 * t_short,
+                "ms per 1000-frame clip": 1e3 * t_long,
+                "rebuild (fit) ms": 1e3 * t_fit,
+                "rebuild / add a 20-frame clip": t_fit / t_short,
+            }
+        )
+    return rows
+
+
+def growth(sets):
+    rows = []
+    for name, loader in sets.items():
+        Xtr, ytr, Xte, yte = loader()
+        rebuilt = MotionTreeHMM().fit(Xtr, ytr)
+        row = {
+            "data": name,
+            "train clips": len(Xtr),
+            "rebuilt accuracy": rebuilt.score(Xte, yte),
+        }
+        for label, kwargs in (
+            ("grown, no splits", {"split_growth": None}),
+            ("grown, splits x2", {}),
+            ("grown, splits x2 + rebuild 1 sd", {"rebuild_tol": 1.0}),
+        ):
+            start = time.perf_counter()
+            model = grow(MotionTreeHMM(), Xtr, ytr, **kwargs)
+            seconds = time.perf_counter() - start
+            row[label] = model.score(Xte, yte)
+            row[label + ", nodes"] = model.tree_.n_tree_nodes
+            row[label + ", s"] = seconds
+        row["rebuilt, nodes"] = rebuilt.tree_.n_tree_nodes
+        rows.append(row)
+        print(row)
+    return rows
+
+
+def stream_clip(quick):
+    """A model of 32 virtual markers (192 channels) and a long test clip."""
+    if (SHARED_DATA / "cmu-asfamc").is_dir() and not quick:
+        Xtr, ytr, Xte, _ = cmu_windows()
+        clip = np.concatenate(Xte[:10])
+        return MotionTreeHMM().fit(Xtr, ytr), clip, "CMU 02 virtual markers"
+    from skmotion.datasets import make_walks
+    from skmotion.io import as_motions
+    from skmotion.preprocessing import VirtualMarkerTransform
+
+    walks = make_walks(2, random_state=0)
+    X = VirtualMarkerTransform().fit_transform(
+        as_motions(walks.clips, walks.skeletons, walks.frame_rate)
+    )
+    return MotionTreeHMM().fit(X[1:], walks.target[1:]), X[0], "synthetic walks, virtual markers"
+
+
+def stream_cost(quick):
+    model, clip, source = stream_clip(quick)
+    n = min(len(clip), 120 if quick else 300)
+    clip = clip[:n]
+
+    def batch():
+        model.predict([clip])
+        model.decode([clip])
+
+    rows = []
+    for window in (30, None):
+        for chunk in (1, 10, 30):
+
+            def run(window=window, chunk=chunk):
+                stream = model.stream(window=window)
+                for start in range(0, n, chunk):
+                    stream.update(clip[start : start + chunk])
+
+            # in alternation with the batch calls, so both see the same load
+            seconds, batch_s = interleaved([run, batch], rounds=3)
+            rows.append(
+                {
+                    "data": source,
+                    "channels": clip.shape[1],
+                    "layers": model.n_layers_,
+                    "frames": n,
+                    "window": "all" if window is None else window,
+                    "chunk": chunk,
+                    "us per frame": 1e6 * seconds / n,
+                    "us per update": 1e6 * seconds / -(-n // chunk),
+                    "batch predict+decode, us per frame": 1e6 * batch_s / n,
+                    "stream / batch": seconds / batch_s,
+                }
+            )
+    return rows
+
+
+def latency(sets):
+    rows = []
+    for name, loader in sets.items():
+        Xtr, ytr, Xte, yte = loader()
+        model = MotionTreeHMM().fit(Xtr, ytr)
+        shares, frames, correct = [], [], []
+        for clip, label in zip(Xte, yte):
+            stream = model.stream()
+            decisions = np.array([stream.update(frame).label == label for frame in clip])
+            correct.append(decisions[-1])
+            if decisions[-1]:
+                wrong = np.flatnonzero(~decisions)
+                first = 0 if not len(wrong) else wrong[-1] + 1
+                shares.append((first + 1) / len(clip))
+                frames.append(first + 1)
+        rows.append(
+            {
+                "data": name,
+                "test clips": len(Xte),
+                "correct at the end": float(np.mean(correct)),
+                "batch accuracy": model.score(Xte, yte),
+                "median share of clip to a settled correct decision": float(np.median(shares)),
+                "median frames": float(np.median(frames)),
+                "90th percentile share": float(np.percentile(shares, 90)),
+            }
+        )
+        print(rows[-1])
+    return rows
+
+
+def synthesis(sets):
+    rows = []
+    for name, loader in sets.items():
+        Xtr, ytr, _, _ = loader()
+        model = MotionTreeHMM().fit(Xtr, ytr)
+        length = int(np.median([len(c) for c in Xtr]))
+        row = {"data": name, "classes": len(model.classes_), "chance": 1 / len(model.classes_)}
+        for smoothness in (0.0, 1.0, 2.0):
+            hits = []
+            for label in model.classes_:
+                samples = [
+                    model.sample(length, y=label, random_state=s, smoothness=smoothness).frames
+                    for s in range(10)
+                ]
+                hits.append(np.mean(model.predict(samples) == label))
+            row[f"recognised, smoothness {smoothness:g}"] = float(np.mean(hits))
+            row[f"worst class, smoothness {smoothness:g}"] = float(np.min(hits))
+        row["frames per sample"] = length
+        rows.append(row)
+    return rows
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="small sizes, synthetic data only")
+    parser.add_argument(
+        "--only", nargs="*", help="update, growth, stream, latency, synthesis (default: all)"
+    )
+    args = parser.parse_args()
+    only = set(args.only or ["update", "growth", "stream", "latency", "synthesis"])
+    sets = datasets(args.quick)
+    note = "Shared machine: compare ratios within one run. Default MotionTreeHMM parameters."
+    if "update" in only:
+        write_results("live_update_cost", update_cost(args.quick), notes=note)
+    if "stream" in only:
+        write_results("live_stream_cost", stream_cost(args.quick), notes=note)
+    if "growth" in only:
+        write_results("live_growth", growth(sets), notes=note)
+    if "latency" in only:
+        write_results("live_latency", latency(sets), notes=note)
+    if "synthesis" in only:
+        write_results("live_synthesis", synthesis(sets), notes=note)
+
+
+if __name__ == "__main__":
+    main()
