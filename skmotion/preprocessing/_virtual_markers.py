@@ -158,7 +158,7 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
     >>> kinect = make_position_motions("kinect_v2", n_clips_per_class=1, random_state=0)
     >>> vmt = VirtualMarkerTransform(layout="kinect_v2", frame_rate=kinect.frame_rate)
     >>> vmt.fit_transform(kinect.clips)[0].shape, vmt.marker_names_[:3].tolist()
-    ((60, 96), ['head', 'neck', 'chest'])
+    ((88, 126), ['head', 'neck', 'chest'])
     """
 
     _parameter_constraints = {
