@@ -1,6 +1,7 @@
 """Preprocessing: clip-to-clip transformers and the steps that bridge to sklearn."""
 
 from skmotion.preprocessing._body_frame import body_frame_features, body_size
+from skmotion.preprocessing._fill_gaps import FillGaps
 from skmotion.preprocessing._filter import LowPassFilter, filter_min_frames, lowpass_filter
 from skmotion.preprocessing._flatten import FlattenClips
 from skmotion.preprocessing._layouts import Layout
@@ -24,6 +25,7 @@ from skmotion.preprocessing._segment import (
 from skmotion.preprocessing._virtual_markers import SIZE_CHAIN, VirtualMarkerTransform, to_markers
 
 __all__ = [
+    "FillGaps",
     "FlattenClips",
     "LAYOUTS",
     "Layout",
