@@ -1,16 +1,20 @@
 """Point trajectories in the body frame, in 2-D or 3-D: chunked over frames and scale-safe.
 
-The computation of :class:`VirtualMarkerTransform` on point positions. Two
-things make it robust where a direct formula is not:
+The computation of :class:`VirtualMarkerTransform` on point positions. Per
+frame the body frame is one matrix ``M`` (rotation about the vertical, the
+up-axis flip and the division by the body size folded together) and a shift
+``t``, so the features are ``p @ M.T - t``: one batched ``matmul`` per chunk.
+Three things make it robust and fast where a direct formula is not:
 
-- **scale**: the points are first multiplied by a power of two that brings the
-  largest coordinate into ``[0.5, 1)``. That is exact in floating point, so the
-  result is bit-for-bit the unscaled one, but no square or product can
-  overflow or underflow (clips of 1e-150 or 1e160 metres work); a body that is
-  lost in rounding (its size below ~1e-10 of its largest coordinate) is a clear
-  error instead of a division by zero;
+- **scale**: no square of a coordinate is ever formed: the body size is
+  computed on the chain points multiplied by a power of two (exact) that brings
+  them into ``[0.5, 1)``, the facing uses ``hypot``, and ``M`` holds unit
+  vectors divided by the size, so clips of 1e-150 or 1e160 metres give the
+  same features; a body lost in rounding (its size below ~1e-10 of its
+  coordinates) is a clear error instead of a division by zero;
 - **memory**: the output array is allocated once and filled in chunks of
-  frames, so the temporaries stay a few MB whatever the clip length.
+  frames, so the temporaries stay a few MB whatever the clip length;
+- **speed**: without velocities ``matmul`` writes straight into the output.
 """
 
 import numpy as np
@@ -49,23 +53,12 @@ def chain_size(points, chain):
 
 
 def _power_of_two_scale(points):
-    """A power of two that brings the largest finite |coordinate| into [0.5, 1)."""
-    peak = float(np.max(np.abs(points))) if points.size else 0.0
-    if not np.isfinite(peak) or peak == 0.0:
+    """1, or a power of two that brings the largest |coordinate| into [0.5, 1) when squares
+    of the coordinates could overflow or lose precision (beyond 1e100 or below 1e-100)."""
+    peak = max(float(np.max(points)), -float(np.min(points))) if points.size else 0.0
+    if not np.isfinite(peak) or peak == 0.0 or 1e-100 < peak < 1e100:
         return 1.0
     return float(np.ldexp(1.0, -np.frexp(peak)[1]))
-
-
-def _up_frame(points, up):
-    """The points turned so that axis ``up`` (``"-y"`` allowed) points up, handedness kept."""
-    axis = "xyz".index(up[-1])
-    if not up.startswith("-"):
-        return points, axis
-    flipped = points.copy()
-    flipped[..., axis] *= -1
-    if points.shape[-1] == 3:  # a half turn about another axis keeps a right-handed frame
-        flipped[..., (axis + 2) % 3] *= -1
-    return flipped, axis
 
 
 def _lateral(p, lefts, rights):
@@ -139,44 +132,68 @@ def position_frame_features(
     if dim == 2 and up not in ("y", "-y"):
         raise ValueError(f"2-D points need up='y' or up='-y' (image rows); got {up!r}")
     axis = "xyz".index(up[-1])
-    scale = _power_of_two_scale(points)
-    size = 1.0
-    if size_chain is not None:
-        chain = list(size_chain)
-        size = chain_size(points[:, chain] * scale, range(len(chain)))
-        if not size > _TINY:
-            what = "0" if size == 0 else f"{size / scale:.3g}"
-            raise ValueError(
-                f"the body size along the size chain is {what} while coordinates reach "
-                f"{0.5 / scale:.3g}: the body is lost in floating-point rounding (or the size "
-                "joints coincide); centre the clip or check the size joints"
-            )
+    flip = _flip(dim, up)
+    size = 1.0 if size_chain is None else _safe_size(points[:, list(size_chain)])
+    if isinstance(floor, str):
+        heights = points[..., axis]
+        level = float(np.min(heights) if flip[axis] > 0 else -np.max(heights))
+    else:
+        level = float(floor) * flip[axis]
     per_point = dim * (2 if velocities else 1)
     n_out = n_points if outputs is None else len(outputs)
     outputs = None if outputs is None else np.asarray(outputs, dtype=np.intp)
     out = np.empty((n_frames, n_out, per_point))
-    sign = 1.0
     if dim == 2:
-        lateral = _lateral(points[..., 0], lefts, rights)
-        sign = -1.0 if np.median(lateral) < 0 else 1.0
-    flip = -1.0 if up.startswith("-") else 1.0
-    if isinstance(floor, str):
-        heights = points[..., axis]
-        level = (np.min(heights) if flip > 0 else -np.max(heights)) * scale
-    else:
-        level = float(floor) * scale * flip
+        # One mirror sign per clip: the subject's left positive (median over frames).
+        sign = -1.0 if np.median(_lateral(points[..., 0], lefts, rights)) < 0 else 1.0
     for start in range(0, n_frames, chunk):
         stop = min(start + chunk, n_frames)
-        lo, hi = max(start - 1, 0), min(stop + 1, n_frames)
-        block = _up_frame(points[lo:hi] * scale, up)[0]
-        args = (block, outputs, start - lo, stop - lo, root, lefts, rights, level, size, start)
+        p = points[start:stop]
         if dim == 3:
-            _fill_3d(out[start:stop], *args, frame_rate, velocities, axis)
+            matrix_t, shift = _frames_3d(p, root, lefts, rights, level, size, flip, axis, start)
         else:
-            _fill_2d(out[start:stop], *args, frame_rate, velocities, sign)
-    if size_chain is None:
-        out /= scale
+            matrix_t = np.diag([sign, flip[1]]) / size
+            origin = p[:, list(root), 0].mean(axis=1)
+            shift = np.stack([origin * (sign / size), np.full(len(p), level / size)], axis=1)
+        q = p if outputs is None else p[:, outputs]
+        positions = out[start:stop, :, :dim]
+        if velocities:  # matmul writes fast only into contiguous arrays
+            positions = np.empty((stop - start, n_out, dim))
+        np.matmul(q, matrix_t, out=positions)
+        positions -= shift[:, None, :]
+        if velocities:
+            out[start:stop, :, :dim] = positions
+            lo, hi = max(start - 1, 0), min(stop + 1, n_frames)
+            block = points[lo:hi] if outputs is None else points[lo:hi, outputs]
+            v = _velocity(block, start - lo, stop - lo, frame_rate)
+            out[start:stop, :, dim:] = np.matmul(v, matrix_t)
     return out.reshape(n_frames, n_out * per_point)
+
+
+def _flip(dim, up):
+    """Signs that turn the input so that ``up`` points up (a half turn keeps handedness)."""
+    flip = np.ones(dim)
+    if up.startswith("-"):
+        axis = "xyz".index(up[-1])
+        flip[axis] = -1.0
+        if dim == 3:
+            flip[(axis + 2) % 3] = -1.0
+    return flip
+
+
+def _safe_size(chain_points):
+    """Body size along a chain, computed on power-of-two scaled points (no overflow)."""
+    scale = _power_of_two_scale(chain_points)
+    scaled = chain_points if scale == 1.0 else chain_points * scale
+    size = chain_size(scaled, range(chain_points.shape[1]))
+    if not size > _TINY * np.abs(scaled).max(initial=0.0):
+        what = "0" if size == 0 else f"{size / scale:.3g}"
+        raise ValueError(
+            f"the body size along the size chain is {what} while coordinates reach "
+            f"{np.abs(chain_points).max():.3g}: the body is lost in floating-point rounding (or the size "
+            "joints coincide); centre the clip or check the size joints"
+        )
+    return size / scale
 
 
 def _velocity(block, a, b, frame_rate):
@@ -187,46 +204,28 @@ def _velocity(block, a, b, frame_rate):
     return np.gradient(block, axis=0)[a:b] * frame_rate
 
 
-def _fill_3d(
-    out, block, outputs, a, b, root, lefts, rights, level, size, start, frame_rate, velocities, up
-):
-    p = block[a:b]
+def _frames_3d(p, root, lefts, rights, level, size, flip, up, start):
+    """Per frame, ``M.T`` and the shift ``t`` with body-frame points ``p @ M.T - t``."""
     h1, h2 = (up + 1) % 3, (up + 2) % 3
-    lateral = _lateral(p, lefts, rights)
+    lateral = _lateral(p, lefts, rights) * flip
     l1, l2 = lateral[:, h1], lateral[:, h2]
     norm = np.hypot(l1, l2)
-    flat = np.flatnonzero(~(norm > _TINY * max(size, _TINY)))
+    flat = np.flatnonzero(~(norm > _TINY * np.abs(lateral).max(axis=1, initial=0.0)))
     if flat.size:
         raise ValueError(
             f"the left and right facing markers are vertically aligned at frame {start + flat[0]}: "
             "no facing direction on the floor"
         )
-    # (h1, h2, up) is right-handed, so forward = left x up = (l2, -l1) in (h1, h2).
-    c1 = (l1 / (norm * size))[:, None]
-    c2 = (l2 / (norm * size))[:, None]
+    c1, c2 = l1 / norm / size, l2 / norm / size
+    # Columns of M.T (rows of M): forward, left, up in the flipped input axes; (h1, h2, up)
+    # is right-handed, so forward = left x up = (l2, -l1) in (h1, h2). Built transposed and
+    # contiguous because matmul is several times faster so.
+    matrix_t = np.zeros((len(p), 3, 3))
+    matrix_t[:, h1, 0], matrix_t[:, h2, 0] = c2, -c1
+    matrix_t[:, h1, 1], matrix_t[:, h2, 1] = c1, c2
+    matrix_t[:, up, 2] = 1.0 / size
+    matrix_t *= flip[:, None]  # undo the up-axis flip on the input side
     origin = p[:, list(root)].mean(axis=1)
-    q = p if outputs is None else p[:, outputs]
-    d1 = q[..., h1] - origin[:, None, h1]
-    d2 = q[..., h2] - origin[:, None, h2]
-    out[..., 0] = c2 * d1 - c1 * d2
-    out[..., 1] = c1 * d1 + c2 * d2
-    out[..., 2] = (q[..., up] - level) / size
-    if velocities:
-        v = _velocity(block if outputs is None else block[:, outputs], a, b, frame_rate)
-        out[..., 3] = c2 * v[..., h1] - c1 * v[..., h2]
-        out[..., 4] = c1 * v[..., h1] + c2 * v[..., h2]
-        out[..., 5] = v[..., up] / size
-
-
-def _fill_2d(
-    out, block, outputs, a, b, root, lefts, rights, level, size, start, frame_rate, velocities, sign
-):
-    p = block[a:b]
-    origin = p[:, list(root), 0].mean(axis=1)
-    q = p if outputs is None else p[:, outputs]
-    out[..., 0] = (q[..., 0] - origin[:, None]) * (sign / size)
-    out[..., 1] = (q[..., 1] - level) / size
-    if velocities:
-        v = _velocity(block if outputs is None else block[:, outputs], a, b, frame_rate)
-        out[..., 2] = v[..., 0] * (sign / size)
-        out[..., 3] = v[..., 1] / size
+    shift = np.einsum("fj,fji->fi", origin, matrix_t)
+    shift[:, 2] = level / size
+    return matrix_t, shift
