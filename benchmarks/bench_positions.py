@@ -154,14 +154,19 @@ def _run_lengths(mask):
     return out
 
 
-def _rate(func, n_frames, repeats=5):
-    func()
-    cpu, wall = time.process_time(), time.perf_counter()
-    for _ in range(repeats):
-        func()
-    return n_frames * repeats / (time.process_time() - cpu), n_frames * repeats / (
-        time.perf_counter() - wall
-    )
+def _rates(steps, rounds=5):
+    """Median CPU and wall frames/s of each ``(func, n_frames)``, timed in alternation."""
+    for func, _ in steps.values():
+        func()  # warm-up
+    cpu = {name: [] for name in steps}
+    wall = {name: [] for name in steps}
+    for _ in range(rounds):
+        for name, (func, n_frames) in steps.items():
+            c, w = time.process_time(), time.perf_counter()
+            func()
+            cpu[name].append(n_frames / (time.process_time() - c))
+            wall[name].append(n_frames / (time.perf_counter() - w))
+    return {name: (float(np.median(cpu[name])), float(np.median(wall[name]))) for name in steps}
 
 
 def speed(motions, n_frames):
@@ -170,31 +175,31 @@ def speed(motions, n_frames):
     rows = []
     for name in ("kinect_v2", "mediapipe_pose33", "coco17"):
         layout = get_layout(name, dim=3)
-        base = layout_positions(skeleton, channels, layout)
-        clip = np.tile(base, (reps, 1))[:n_frames]
+        clip = np.tile(layout_positions(skeleton, channels, layout), (reps, 1))[:n_frames]
         if LAYOUTS[name].dim == 2:  # image keypoints: drop depth (a projection does not matter)
             layout = LAYOUTS[name]
             clip = clip.reshape(n_frames, -1, 3)[..., :2].reshape(n_frames, -1)
+        steps = {}
         for velocities in (False, True):
             vmt = VirtualMarkerTransform(
                 layout=layout, markers="all", velocities=velocities, frame_rate=120.0
             ).fit([clip])
-            cpu, wall = _rate(partial(vmt.transform, [clip]), n_frames)
-            rows.append(_speed_row(name, f"layout transform, velocities={velocities}", cpu, wall))
+            steps[f"layout transform, velocities={velocities}"] = (
+                partial(vmt.transform, [clip]),
+                n_frames,
+            )
         if layout.dim == 3:
             points = clip.reshape(n_frames, layout.n_joints, 3)
             left, right = layout.index(layout.left_hip), layout.index(layout.right_hip)
-
             previous = partial(
                 body_frame_features, points, frame_rate=120.0, root=left, left=left, right=right
             )
-            cpu, wall = _rate(previous, n_frames, repeats=2)
-            rows.append(_speed_row(name, "previous body_frame_features (velocities)", cpu, wall))
-        rng = np.random.default_rng(0)
-        holed, _ = cut_gaps(clip[:20_000], layout.dim, rng, 0.10)
+            steps["previous body_frame_features (velocities)"] = (previous, n_frames)
+        holed, _ = cut_gaps(clip[:20_000], layout.dim, np.random.default_rng(0), 0.10)
         fill = FillGaps(max_gap=30, layout=layout).fit([holed])
-        cpu, wall = _rate(partial(fill.transform, [holed]), len(holed), repeats=2)
-        rows.append(_speed_row(name, "FillGaps, 10% missing", cpu, wall))
+        steps["FillGaps, 10% missing"] = (partial(fill.transform, [holed]), len(holed))
+        for step, (cpu, wall) in _rates(steps).items():
+            rows.append(_speed_row(name, step, cpu, wall))
     return rows
 
 
@@ -335,6 +340,7 @@ def main(argv=None):
     parser.add_argument("--data", default=default, help="the shared data folder")
     parser.add_argument("--before-src", help="a source tree of an older skmotion, for memory")
     parser.add_argument("--figure", action="store_true", help="write docs/images/positions_*.png")
+    parser.add_argument("--only-speed", action="store_true", help="only the timings")
     args = parser.parse_args(argv)
     data = Path(args.data)
     if not (data / "cmu-asfamc").is_dir():
@@ -345,6 +351,9 @@ def main(argv=None):
     n_frames = sum(len(m.channels) for _, m in motions)
     rng = np.random.default_rng(0)
     note = f"{len(motions)} CMU trials (subjects 01-03), {n_frames} frames at 120 Hz."
+    if args.only_speed:
+        write_results("positions_speed", speed(motions, 100_000), notes="10^5-frame clips.")
+        return
     fill_rows = fill_errors(motions, rng)
     write_results("positions_fill", fill_rows, notes=note)
     if args.figure:
