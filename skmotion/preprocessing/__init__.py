@@ -22,7 +22,8 @@ from skmotion.preprocessing._segment import (
     zero_velocity_crossings,
     zvc_segments,
 )
-from skmotion.preprocessing._virtual_markers import SIZE_CHAIN, VirtualMarkerTransform, to_markers
+from skmotion.preprocessing._to_markers import to_markers
+from skmotion.preprocessing._virtual_markers import SIZE_CHAIN, VirtualMarkerTransform
 
 __all__ = [
     "FillGaps",
