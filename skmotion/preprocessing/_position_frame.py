@@ -190,8 +190,8 @@ def _safe_size(chain_points):
         what = "0" if size == 0 else f"{size / scale:.3g}"
         raise ValueError(
             f"the body size along the size chain is {what} while coordinates reach "
-            f"{np.abs(chain_points).max():.3g}: the body is lost in floating-point rounding (or the size "
-            "joints coincide); centre the clip or check the size joints"
+            f"{np.abs(chain_points).max():.3g}: the body is lost in floating-point rounding "
+            "(or the size joints coincide); centre the clip or check the size joints"
         )
     return size / scale
 
