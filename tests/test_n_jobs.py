@@ -15,11 +15,12 @@ from sklearn.base import clone
 from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor, _clip_svd
 from skmotion.neighbors import IntervalIndexNeighbors, _interval_neighbors, _psi, pairwise_psi
-from skmotion.preprocessing import LowPassFilter, VirtualMarkerTransform
+from skmotion.preprocessing import FillGaps, LowPassFilter, VirtualMarkerTransform
 from skmotion.tree import MotionTreeHMM, _batch
 from skmotion.utils import _parallel
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
+from tests.preprocessing.test_fill_gaps import _holed_case as _holed_positions
 from tests.test_persistence import _motions, skmotion_estimators
 
 
@@ -94,6 +95,7 @@ CASES = {
         None,
     ),
     "LowPassFilter": (LowPassFilter(order=4), _motions, None),
+    "FillGaps": (FillGaps(layout="kinect_v1"), _holed_positions, None),
 }
 
 

@@ -17,6 +17,7 @@ from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
 from skmotion.neighbors import IntervalIndexNeighbors
 from skmotion.preprocessing import (
+    FillGaps,
     FlattenClips,
     LowPassFilter,
     ResampleClips,
@@ -25,6 +26,7 @@ from skmotion.preprocessing import (
 from skmotion.tree import MotionTreeHMM
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
+from tests.preprocessing.test_fill_gaps import _holed_case as _holed_positions
 
 
 def _motions():
@@ -100,6 +102,7 @@ CASES = {
     "ResampleClips": (ResampleClips(n_frames=7, kind="cubic"), _motions, {}),
     "FlattenClips": (FlattenClips(), _equal_length, {}),
     "LowPassFilter": (LowPassFilter(order=4), _motions, {}),
+    "FillGaps": (FillGaps(layout="kinect_v1"), _holed_positions, {}),
 }
 
 

@@ -9,22 +9,32 @@ from skmotion.datasets._motion_files import (
     load_motion_folder,
     read_cmu_index,
 )
+from skmotion.datasets._positions import (
+    EXTRA_LANDMARKS,
+    layout_markers,
+    layout_positions,
+    make_position_motions,
+)
 from skmotion.datasets._repeats import make_repeated_motions
 from skmotion.datasets._synthetic import MOTION_CLASSES, make_motions
 from skmotion.datasets._uea import load_uea
 from skmotion.datasets._walks import WALK_DIRECTIONS, make_walks
 
 __all__ = [
+    "EXTRA_LANDMARKS",
     "MOTION_CLASSES",
     "WALK_DIRECTIONS",
     "fetch_cmu_mocap",
     "get_data_home",
     "humanoid_skeleton",
+    "layout_markers",
+    "layout_positions",
     "load_bvh_folder",
     "load_cmu_asfamc",
     "load_motion_folder",
     "load_uea",
     "make_motions",
+    "make_position_motions",
     "make_repeated_motions",
     "make_walks",
     "read_cmu_index",

@@ -3,24 +3,26 @@
 from numbers import Integral, Real
 
 import numpy as np
-from sklearn.base import BaseEstimator, clone
+from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipTransformerMixin, MotionTags
 from skmotion.io._motion import Motion
 from skmotion.kinematics import Skeleton
-from skmotion.preprocessing._body_frame import body_frame_features, body_size
+from skmotion.preprocessing._layouts import Layout, layout_plan
 from skmotion.preprocessing._marker_presets import MARKER_NAMES, MARKER_PRESETS, marker_preset
 from skmotion.preprocessing._marker_set import MarkerSet
+from skmotion.preprocessing._named_layouts import LAYOUTS, get_layout
+from skmotion.preprocessing._position_frame import CHUNK, position_frame_features
 from skmotion.utils._clips import check_clips
 from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
-__all__ = ["SIZE_CHAIN", "VirtualMarkerTransform", "to_markers"]
+__all__ = ["SIZE_CHAIN", "VirtualMarkerTransform"]
 
 #: The default chain of :func:`body_size`: ankle to head top along the body.
 SIZE_CHAIN = ("left_ankle", "left_knee", "left_hip", "pelvis", "spine", "chest", "neck", "head_top")
-_COMPONENTS = ("px", "py", "pz", "vx", "vy", "vz")
+_COMPONENTS = {3: ("px", "py", "pz", "vx", "vy", "vz"), 2: ("py", "pz", "vy", "vz")}
 
 
 class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
@@ -45,8 +47,16 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
       skeleton and frame rate (several subjects, several skeleton families);
     - **plain arrays with** ``skeleton``: every clip uses that skeleton;
     - **plain arrays with** ``skeleton=None``: the clips already hold 3-D
-      marker positions, ``3 * n_markers`` channels (Kinect-style trackers),
-      named by ``markers``; only steps 2-3 run.
+      marker positions, ``3 * n_markers`` channels, named by ``markers``; only
+      steps 2-3 run;
+    - **plain arrays with** ``layout``: joint positions of a tracker or pose
+      estimator (:func:`get_layout`: Kinect, Azure Kinect, COCO, OpenPose,
+      MediaPipe, Human3.6M, SMPL, or your own :class:`Layout`), ``dim`` channels
+      per joint; the layout gives the root (the mid-hip), the facing (hips and
+      shoulders), the size chain (ankle, knee, hip, shoulder) and the up axis.
+      2-D layouts stay in the image plane: outputs ``(py, pz[, vy, vz])`` per
+      marker, ``z`` the image's up and ``y`` horizontal, signed so that the
+      subject's left is positive over the clip (depth, ``x``, is unknown).
 
     With ``markers="auto"`` each skeleton gets its family's preset
     (:func:`marker_preset`), so clips of different skeletons share the same
@@ -57,12 +67,20 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
     skeleton : Skeleton, default=None
         The skeleton of plain-array clips; None for marker-position input (or
         when every clip is a Motion).
-    markers : "auto", str, MarkerSet or list, default="auto"
+    markers : "auto", "all", str, MarkerSet or list, default="auto"
         With a skeleton: ``"auto"`` (the preset detected from the joint
         names), a preset name from :data:`MARKER_PRESETS`, a
         :class:`MarkerSet` or a list of ``(name, joint, offset)``. For marker
         positions: the input markers' names, in channel order (``"auto"``
-        means :data:`MARKER_NAMES`).
+        means :data:`MARKER_NAMES`). With a layout: ``"auto"`` outputs the
+        joints on the shared :data:`MARKER_NAMES` (named by the marker, so
+        clips of different systems share features), ``"all"`` every joint
+        under its own name, a list those joints.
+    layout : str or Layout, default=None
+        The joint layout of position clips (a name from :data:`LAYOUTS` or a
+        :class:`Layout`); its roles replace ``root_marker``,
+        ``facing_markers`` and a list of ``size_markers``, which must keep
+        their defaults.
     root_marker : str or int, default="pelvis"
         The marker the origin lies below.
     facing_markers : tuple of (str or int), default=("left_hip", "right_hip")
@@ -74,12 +92,16 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
     floor : "lowest" or float, default="lowest"
         The floor height in the world: the lowest marker over each clip, or a
         given height (in the input's length unit).
-    up_axis : {"x", "y", "z"}, default=None
-        The world's vertical axis; None takes each skeleton's ``up_axis``
-        (``"y"`` for marker positions).
+    up_axis : {"x", "y", "z", "-x", "-y", "-z"}, default=None
+        The world's vertical axis (``"-y"``: ``y`` points down); None takes
+        each skeleton's ``up_axis``, the layout's ``up``, or ``"y"`` for marker
+        positions.
+    velocities : bool, default=True
+        Append each marker's velocity; without them ``frame_rate`` is not
+        needed and the output has half the channels.
     frame_rate : float, default=None
-        Frames per second of plain-array clips. Motions use their own rate;
-        if given, it must agree with theirs.
+        Frames per second of plain-array clips (for velocities). Motions use
+        their own rate; if given, it must agree with theirs.
     n_jobs : int, default=None
         Clips transformed in parallel (joblib threads); None is serial.
 
@@ -92,13 +114,20 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
     marker_names_ : ndarray of str
         The output markers, in order.
     n_markers_ : int
-        Number of markers; the output has ``6 * n_markers_`` channels.
-    root_index_ : int
-        Index in ``marker_names_`` of ``root_marker``.
+        Number of markers; the output has ``6 * n_markers_`` channels (3-D with
+        velocities; 3 without, 4 or 2 in 2-D).
+    layout_ : Layout or None
+        The resolved layout.
+    root_index_ : int or tuple of int
+        Index in ``marker_names_`` of ``root_marker``; with a layout, the input
+        joints whose mean is the root.
     facing_indices_ : tuple of int
-        Indices of the left and right ``facing_markers``.
+        Indices of the left and right ``facing_markers``; with a layout,
+        ``((left_hip, left_shoulder), (right_hip, right_shoulder))`` joint
+        indices.
     size_indices_ : list of int or None
-        Indices of the ``size_markers`` chain; None without size normalisation.
+        Indices of the ``size_markers`` chain (input joints with a layout);
+        None without size normalisation.
 
     See Also
     --------
@@ -122,16 +151,26 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
     >>> out = markers.transform(motions)
     >>> out[0].shape, markers.get_feature_names_out()[:3].tolist()
     ((88, 192), ['head_top_px', 'head_top_py', 'head_top_pz'])
+
+    Joint positions of a tracker:
+
+    >>> from skmotion.datasets import make_position_motions
+    >>> kinect = make_position_motions("kinect_v2", n_clips_per_class=1, random_state=0)
+    >>> vmt = VirtualMarkerTransform(layout="kinect_v2", frame_rate=kinect.frame_rate)
+    >>> vmt.fit_transform(kinect.clips)[0].shape, vmt.marker_names_[:3].tolist()
+    ((88, 126), ['head', 'neck', 'chest'])
     """
 
     _parameter_constraints = {
         "skeleton": [Skeleton, None],
-        "markers": [StrOptions({"auto", *MARKER_PRESETS}), MarkerSet, list, tuple],
+        "markers": [StrOptions({"auto", "all", *MARKER_PRESETS}), MarkerSet, list, tuple],
+        "layout": [StrOptions(set(LAYOUTS)), Layout, None],
         "root_marker": [str, Integral],
         "facing_markers": [tuple, list],
         "size_markers": [StrOptions({"auto"}), tuple, list, None],
         "floor": [StrOptions({"lowest"}), Real],
-        "up_axis": [StrOptions({"x", "y", "z"}), None],
+        "up_axis": [StrOptions({"x", "y", "z", "-x", "-y", "-z"}), None],
+        "velocities": ["boolean"],
         "frame_rate": [Interval(Real, 0, None, closed="neither"), None],
         "n_jobs": [Integral, None],
     }
@@ -142,21 +181,25 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         skeleton=None,
         *,
         markers="auto",
+        layout=None,
         root_marker="pelvis",
         facing_markers=("left_hip", "right_hip"),
         size_markers="auto",
         floor="lowest",
         up_axis=None,
+        velocities=True,
         frame_rate=None,
         n_jobs=None,
     ):
         self.skeleton = skeleton
         self.markers = markers
+        self.layout = layout
         self.root_marker = root_marker
         self.facing_markers = facing_markers
         self.size_markers = size_markers
         self.floor = floor
         self.up_axis = up_axis
+        self.velocities = velocities
         self.frame_rate = frame_rate
         self.n_jobs = n_jobs
 
@@ -168,23 +211,26 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         if any(is_motion) and not all(is_motion) and self.skeleton is None:
             plain = is_motion.index(False)
             raise ValueError(
-                f"X: clip {plain} is a plain array while other clips are Motions; give skeleton= for "
-                "plain arrays, or make every clip a Motion."
+                f"X: clip {plain} is a plain array while other clips are Motions; give "
+                "skeleton= for plain arrays, or make every clip a Motion."
             )
         sources = []
         for i, (item, motion) in enumerate(zip(items, is_motion)):
             if motion:
                 if self.frame_rate is not None and not np.isclose(item.frame_rate, self.frame_rate):
                     raise ValueError(
-                        f"X: clip {i} is a Motion at {item.frame_rate:g} Hz, but frame_rate={self.frame_rate:g}."
+                        f"X: clip {i} is a Motion at {item.frame_rate:g} Hz, but "
+                        f"frame_rate={self.frame_rate:g}."
                     )
                 sources.append((item.skeleton, item.frame_rate))
             else:
-                if self.frame_rate is None:
+                if self.frame_rate is None and self.velocities:
                     raise ValueError(
-                        f"X: clip {i} is a plain array; give frame_rate= (Hz) for velocities, or pass Motions."
+                        f"X: clip {i} is a plain array; give frame_rate= (Hz) for velocities, "
+                        "or pass Motions."
                     )
-                sources.append((self.skeleton, float(self.frame_rate)))
+                rate = None if self.frame_rate is None else float(self.frame_rate)
+                sources.append((self.skeleton, rate))
         return sources
 
     def marker_set(self, skeleton):
@@ -217,8 +263,8 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         """Names of the markers of marker-position input (``skeleton=None``)."""
         if n_channels % 3:
             raise ValueError(
-                f"X has {n_channels} channels; marker positions (skeleton=None) need 3 per marker. Give "
-                "skeleton= for joint-angle clips."
+                f"X has {n_channels} channels; marker positions (skeleton=None) need 3 per "
+                "marker. Give skeleton= for joint-angle clips."
             )
         if isinstance(self.markers, MarkerSet):
             names = self.markers.names
@@ -228,8 +274,8 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
             names = tuple(str(m) for m in self.markers)
         if len(names) != n_channels // 3:
             raise ValueError(
-                f"X has {n_channels // 3} markers (3 channels each), but markers names {len(names)}; give the "
-                "input markers' names in channel order."
+                f"X has {n_channels // 3} markers (3 channels each), but markers names "
+                f"{len(names)}; give the input markers' names in channel order."
             )
         return tuple(names)
 
@@ -253,7 +299,8 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
             else:
                 if skeleton.n_channels != clips.n_channels:
                     raise ValueError(
-                        f"X: clip {i} has {clips.n_channels} channels, but its skeleton has {skeleton.n_channels}."
+                        f"X: clip {i} has {clips.n_channels} channels, but its skeleton has "
+                        f"{skeleton.n_channels}."
                     )
                 if skeleton not in resolved:
                     markers = self.marker_set(skeleton)
@@ -265,7 +312,8 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
                 names = clip_names
             elif clip_names != names:
                 raise ValueError(
-                    f"X: clip {i} gets markers {list(clip_names)[:5]}..., other clips {list(names)[:5]}..."
+                    f"X: clip {i} gets markers {list(clip_names)[:5]}..., other clips "
+                    f"{list(names)[:5]}..."
                 )
             plans.append((skeleton, markers, frame_rate))
         return plans, names
@@ -305,11 +353,61 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
             The fitted transformer.
         """
         clips = check_clips(X, estimator=self, reset=True)
+        if self.layout is not None:
+            return self._fit_layout(X, clips)
         _, names = self._plans(X, clips)
         self.root_index_, left, right, self.size_indices_ = self._indices(names)
         self.facing_indices_ = (left, right)
         self.marker_names_ = np.asarray(names, dtype=object)
         self.n_markers_ = len(names)
+        self.layout_ = None
+        return self
+
+    def _fit_layout(self, X, clips):
+        """Fit for joint positions of a layout: the roles come from the layout."""
+        layout = get_layout(self.layout)
+        if self.skeleton is not None or any(isinstance(c, Motion) for c in _items(X)):
+            raise ValueError(
+                "layout= is for joint-position clips (plain arrays); joint-angle clips take "
+                "skeleton= or Motions, without layout=."
+            )
+        custom = [
+            f"{name}={value!r}"
+            for name, value, default in (
+                ("root_marker", self.root_marker, "pelvis"),
+                ("facing_markers", tuple(self.facing_markers), ("left_hip", "right_hip")),
+            )
+            if value != default
+        ]
+        if not (self.size_markers is None or isinstance(self.size_markers, str)):
+            custom.append(f"size_markers={self.size_markers!r}")
+        if custom:
+            raise ValueError(
+                f"With layout={layout.name!r} the root, facing and size joints come from the "
+                f"layout; {', '.join(custom)} would be ignored. Define a Layout with those roles "
+                "instead."
+            )
+        if isinstance(self.markers, MarkerSet) or self.markers in MARKER_PRESETS:
+            raise ValueError(
+                f"markers={self.markers!r} places markers on a skeleton; with a layout use 'auto', "
+                "'all' or a list of joint names."
+            )
+        expected = layout.dim * layout.n_joints
+        if clips.n_channels != expected:
+            raise ValueError(
+                f"X has {clips.n_channels} channels, but layout {layout.name!r} has "
+                f"{layout.n_joints} joints x {layout.dim} coordinates = {expected} channels."
+            )
+        if self.velocities and self.frame_rate is None:
+            raise ValueError("give frame_rate= (Hz) for velocities, or velocities=False.")
+        plan = layout_plan(layout, self.markers)
+        self.layout_ = layout
+        self.root_index_ = plan["root"]
+        self.facing_indices_ = (plan["lefts"], plan["rights"])
+        self.size_indices_ = None if self.size_markers is None else list(plan["size_chain"])
+        self.marker_names_ = np.asarray(plan["names"], dtype=object)
+        self.n_markers_ = len(plan["names"])
+        self._outputs = plan["outputs"]
         return self
 
     def transform(self, X):
@@ -322,48 +420,60 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
 
         Returns
         -------
-        X_new : list of ndarray of shape (n_frames_i, 6 * n_markers_)
-            In the container kind of ``X`` (a DataFrame after
-            ``set_output(transform="pandas")``).
+        X_new : list of ndarray of shape (n_frames_i, n_features_out)
+            ``6 * n_markers_`` channels (3-D with velocities), in the container
+            kind of ``X`` (a DataFrame after ``set_output(transform="pandas")``).
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
-        plans, names = self._plans(X, clips)
-        if list(names) != list(self.marker_names_):
-            raise ValueError("X: the clips' markers differ from those seen in fit.")
-        root, (left, right), chain = self.root_index_, self.facing_indices_, self.size_indices_
-
-        def one(i):
-            skeleton, markers, frame_rate = plans[i]
-            clip = clips[i]
-            if markers is None:
-                positions = clip.reshape(len(clip), -1, 3).astype(float)
-                up = self.up_axis or "y"
-            else:
-                positions = markers.positions(skeleton, clip)
-                up = self.up_axis or skeleton.up_axis
-            size = 1.0 if chain is None else body_size(positions, chain)
-            if not size > 0:
-                raise ValueError(f"X: clip {i} has size 0 along size_markers; check the markers.")
-            try:
-                return body_frame_features(
-                    positions,
-                    frame_rate=frame_rate,
-                    root=root,
-                    left=left,
-                    right=right,
-                    up_axis=up,
-                    floor=self.floor,
-                    size=size,
-                )
-            except ValueError as exc:
-                raise ValueError(f"X: clip {i}: {exc}") from None
-
-        out = parallel_map(one, range(len(clips)), n_jobs=self.n_jobs)
+        if self.layout_ is not None:
+            plans = [(None, None, self.frame_rate)] * len(clips)
+        else:
+            plans, names = self._plans(X, clips)
+            if list(names) != list(self.marker_names_):
+                raise ValueError("X: the clips' markers differ from those seen in fit.")
+        out = parallel_map(
+            lambda i: self._one(clips[i], plans[i], i), range(len(clips)), n_jobs=self.n_jobs
+        )
         return self._wrap_clips(out, clips)
+
+    def _one(self, clip, plan, i):
+        """The features of one clip (``plan``: skeleton, markers, frame rate)."""
+        skeleton, markers, frame_rate = plan
+        outputs, lefts, rights = None, self.facing_indices_[:1], self.facing_indices_[1:]
+        root = (self.root_index_,)
+        if self.layout_ is not None:
+            layout = self.layout_
+            positions = clip.reshape(len(clip), layout.n_joints, layout.dim)
+            up, outputs = self.up_axis or layout.up, self._outputs
+            root, (lefts, rights) = self.root_index_, self.facing_indices_
+        elif markers is None:
+            positions = clip.reshape(len(clip), -1, 3)
+            up = self.up_axis or "y"
+        else:
+            positions = _marker_positions(markers, skeleton, clip)
+            up = self.up_axis or skeleton.up_axis
+        try:
+            return position_frame_features(
+                positions,
+                root=root,
+                lefts=lefts,
+                rights=rights,
+                size_chain=self.size_indices_,
+                up=up,
+                floor=self.floor,
+                frame_rate=frame_rate,
+                velocities=self.velocities,
+                outputs=outputs,
+            )
+        except ValueError as exc:
+            raise ValueError(f"X: clip {i}: {exc}") from None
 
     def get_feature_names_out(self, input_features=None):
         """Output channel names, ``"<marker>_<px|py|pz|vx|vy|vz>"``.
+
+        In 2-D (a 2-D layout) the components are ``py, pz, vy, vz``; without
+        velocities only the positions.
 
         Parameters
         ----------
@@ -375,75 +485,20 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
         feature_names_out : ndarray of str
         """
         check_is_fitted(self)
+        dim = 3 if self.layout_ is None else self.layout_.dim
+        components = _COMPONENTS[dim][: dim * (2 if self.velocities else 1)]
         return np.asarray(
-            [f"{m}_{c}" for m in self.marker_names_ for c in _COMPONENTS], dtype=object
+            [f"{m}_{c}" for m in self.marker_names_ for c in components], dtype=object
         )
 
 
-def to_markers(motions, transformer=None):
-    """Virtual-marker clips of motions from any mix of skeletons, in input order.
+def _items(X):
+    return list(X) if isinstance(X, (list, tuple)) else []
 
-    One :class:`VirtualMarkerTransform` call takes clips that share their
-    channels. Motions of different skeleton families (a CMU ASF subject and
-    a Character Creator BVH, say) have different channels, but the same
-    marker names: this groups the motions by channel layout, fits a clone of
-    ``transformer`` on each group and returns every clip's markers, which all
-    share one feature space.
 
-    Parameters
-    ----------
-    motions : list of Motion
-        The motions, each with its own skeleton and frame rate.
-    transformer : VirtualMarkerTransform, default=None
-        Its parameters are used for every group (default: all defaults).
-
-    Returns
-    -------
-    clips : list of ndarray of shape (n_frames_i, 6 * n_markers)
-        One per motion, in input order.
-    names : ndarray of str
-        The output channel names, shared by every clip.
-
-    Examples
-    --------
-    >>> from skmotion.datasets import make_motions
-    >>> from skmotion.io import Motion, as_motions
-    >>> from skmotion.kinematics import Skeleton
-    >>> from skmotion.preprocessing import VirtualMarkerTransform, to_markers
-    >>> data = make_motions(n_clips_per_class=1, classes=["walk", "wave"], random_state=0)
-    >>> motions = as_motions(data.clips, data.skeletons, data.frame_rate)
-    >>> # A second skeleton family: the humanoid without toes has 6 channels fewer.
-    >>> sk = motions[1].skeleton
-    >>> keep = [j for j, name in enumerate(sk.joints) if "Toe" not in name]
-    >>> bare = Skeleton([sk.joints[j] for j in keep], [keep.index(sk.parents[j]) if j else -1 for j in keep],
-    ...                 sk.offsets[keep], [sk.channels[j] for j in keep], up_axis="y")
-    >>> columns = [c for c, name in enumerate(sk.channel_names) if "Toe" not in name]
-    >>> motions[1] = Motion(bare, motions[1].channels[:, columns], frame_rate=30.0)
-    >>> motions[0].n_channels, motions[1].n_channels
-    (66, 60)
-    >>> clips, names = to_markers(motions, VirtualMarkerTransform(markers=[
-    ...     ("pelvis", "Hips", (0, 0, 0)), ("left_hip", "LeftUpLeg", (0, 0, 0)),
-    ...     ("right_hip", "RightUpLeg", (0, 0, 0)), ("head", "Head", (0, 0, 0))], size_markers=None))
-    >>> [c.shape[1] for c in clips], names[0]
-    ([24, 24], 'pelvis_px')
-    """
-    transformer = VirtualMarkerTransform() if transformer is None else transformer
-    motions = list(motions)
-    bad = [i for i, m in enumerate(motions) if not isinstance(m, Motion)]
-    if bad:
-        raise TypeError(
-            f"motions: item {bad[0]} is a {type(motions[bad[0]]).__name__}, not a Motion."
-        )
-    groups = {}
-    for i, motion in enumerate(motions):
-        groups.setdefault(tuple(motion.channel_names), []).append(i)
-    clips, names = [None] * len(motions), None
-    for rows in groups.values():
-        fitted = clone(transformer).fit([motions[i] for i in rows])
-        group_names = fitted.get_feature_names_out()
-        if names is not None and list(group_names) != list(names):
-            raise ValueError("motions: the skeletons' marker sets have different marker names.")
-        names = group_names
-        for i, clip in zip(rows, fitted.transform([motions[i] for i in rows])):
-            clips[i] = clip
-    return clips, names
+def _marker_positions(markers, skeleton, clip):
+    """Marker world positions, forward kinematics chunk by chunk (bounded memory)."""
+    positions = np.empty((len(clip), len(markers), 3))
+    for start in range(0, len(clip), CHUNK):
+        positions[start : start + CHUNK] = markers.positions(skeleton, clip[start : start + CHUNK])
+    return positions
