@@ -5,6 +5,7 @@ writes a CSV and a Markdown table to ``benchmarks/results/`` (git-ignored).
 """
 
 import csv
+import os
 import platform
 import statistics
 import sys
@@ -15,7 +16,10 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 RESULTS = Path(__file__).resolve().parent / "results"
-SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+# SKMOTION_SHARED_DATA points elsewhere (as for the tests), e.g. from a git worktree.
+SHARED_DATA = Path(
+    os.environ.get("SKMOTION_SHARED_DATA", Path(__file__).resolve().parents[1].parent / "shared" / "data")
+)
 
 
 def time_call(func, *, repeats=5, warmup=1):

@@ -44,6 +44,18 @@ def _rank_tolerance(eigenvalues):
     return eigenvalues.max(axis=-1, keepdims=True) * n * 10 * np.finfo(np.float64).eps
 
 
+def _unit_scale(clip):
+    """The clip divided by its largest absolute value (an all-zero clip unchanged).
+
+    Singular vectors and the shares of the singular values do not change with
+    the clip's scale, but its Gram matrix overflows for values near 1e154 and
+    underflows near 1e-154: scaled to a maximum of 1 it does neither.
+    """
+    clip = np.asarray(clip, dtype=np.float64)
+    peak = np.abs(clip).max() if clip.size else 0.0
+    return clip / peak if peak > 0 else clip
+
+
 def _spectra_of_chunk(chunk, n_vectors):
     n = chunk[0].shape[1]
     eigenvalues = np.zeros((len(chunk), n))
@@ -54,7 +66,7 @@ def _spectra_of_chunk(chunk, n_vectors):
     sizes = np.array([min(len(c), n) for c in chunk])
     for size in np.unique(sizes):
         rows = np.flatnonzero(sizes == size)
-        clips = [np.asarray(chunk[i], dtype=np.float64) for i in rows]
+        clips = [_unit_scale(chunk[i]) for i in rows]
         tall = size == n
         values, vecs = np.linalg.eigh(np.stack([c.T @ c if tall else c @ c.T for c in clips]))
         values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
@@ -90,7 +102,10 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     -------
     eigenvalues : ndarray of shape (n_clips, n_channels)
         Eigenvalues of each ``A^T A`` (the squared singular values of ``A``),
-        in decreasing order; zero beyond the clip's rank.
+        in decreasing order; zero beyond the clip's rank. ``A`` is the clip
+        divided by its largest absolute value: the vectors and the shares of the
+        eigenvalues are what depend on the clip, not its scale, and the scaled
+        Gram matrix neither overflows nor underflows for any finite clip.
     vectors : ndarray of shape (n_clips, n_channels, n_vectors)
         ``vectors[c, :, i]`` is the ``i``-th right singular vector of clip ``c``
         (unit norm, arbitrary sign), or zeros when ``i`` is at or beyond its rank.
@@ -101,7 +116,7 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     >>> from skmotion.decomposition._clip_svd import clip_spectra
     >>> A = np.array([[3.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
     >>> values, vectors = clip_spectra([A], n_vectors=2)
-    >>> values.tolist()
+    >>> (values * 3.0**2).tolist()  # A / 3 was decomposed
     [[9.0, 1.0]]
     >>> np.abs(vectors[0]).tolist()
     [[1.0, 0.0], [0.0, 1.0]]

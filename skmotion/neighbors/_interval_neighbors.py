@@ -3,93 +3,42 @@
 from numbers import Integral, Real
 
 import numpy as np
-import pandas as pd
-import scipy.sparse as sp
-from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.metrics.pairwise import euclidean_distances
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, column_or_1d, validate_data
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.decomposition import SVDFeatureExtractor
-from skmotion.decomposition._clip_svd import clip_spectra, small_blas
-from skmotion.decomposition._svd_features import _N_VECTORS
+from skmotion.decomposition._clip_svd import clip_spectra
+from skmotion.decomposition._svd_projection import (
+    N_VECTORS,
+    fit_svd_projection,
+    max_svd_components,
+    svd_project,
+)
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
+from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_k
+from skmotion.neighbors._store import GrowableStore
+from skmotion.neighbors._widths import learn_delta
 from skmotion.utils._clips import check_clips
-from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, _fit_context
 
-__all__ = ["IntervalIndexNeighbors"]
+__all__ = ["IntervalIndexNeighbors", "learn_delta"]
 
 # Leaves ranked per parallel task: fixed, so results do not depend on n_jobs.
 _LEAVES_PER_TASK = 32
-
-
-def _is_table(X):
-    """A 2-D table of feature vectors rather than a clip collection?
-
-    Clips are a list or tuple of 2-D arrays, a 3-D array or a ``(clip, frame)``
-    DataFrame; anything else (a 2-D array, a list of 1-D rows, a plain DataFrame)
-    is a table.
-    """
-    if isinstance(X, (list, tuple)):
-        # All rows 1-D: a list with one 1-D clip among 2-D ones is a clip collection
-        # with a bad clip, which check_clips names.
-        return len(X) > 0 and all(np.ndim(x) == 1 for x in X)
-    if isinstance(X, np.ndarray):
-        return X.ndim != 3
-    if isinstance(X, pd.DataFrame):
-        return not isinstance(X.index, pd.MultiIndex)
-    # Array-likes are tables; anything else (None, a dict, a file name) goes to
-    # check_clips, whose TypeError names what was given.
-    return sp.issparse(X) or hasattr(X, "__array__")
-
-
-def learn_delta(features, labels, quantile):
-    """Per component, how far apart clips with the same label can be.
-
-    For each label with two or more clips, the range (max - min) of each
-    component over its clips; then the ``quantile`` of these ranges over the
-    labels. ``quantile=1`` is the maximum, the paper's ``delta_i``.
-    """
-    # One pass over the clips sorted by label (not one per label: a collection
-    # of repeated motions has about as many labels as clips).
-    _, codes, counts = np.unique(labels, return_inverse=True, return_counts=True)
-    order = np.argsort(codes.ravel(), kind="stable")
-    starts = np.r_[0, np.cumsum(counts)[:-1]]
-    ordered = features[order]
-    spreads = (
-        np.maximum.reduceat(ordered, starts, axis=0) - np.minimum.reduceat(ordered, starts, axis=0)
-    )[counts > 1]
-    if not len(spreads):
-        return np.zeros(features.shape[1])
-    return np.quantile(spreads, quantile, axis=0)
-
-
-def _extend(buffer, n, new):
-    """Write ``new`` after the first ``n`` rows of ``buffer``, growing it by doubling.
-
-    Insertions then cost amortised O(new rows), not a copy of everything stored.
-    """
-    need = n + len(new)
-    if buffer is None or need > len(buffer):
-        grown = np.empty(
-            (max(need, 2 * (0 if buffer is None else len(buffer))),) + new.shape[1:],
-            dtype=new.dtype,
-        )
-        if buffer is not None:
-            grown[:n] = buffer[:n]
-        buffer = grown
-    buffer[n:need] = new
-    return buffer
+# Levels of the tree when neither n_levels nor features.n_components is given.
+_DEFAULT_LEVELS = 7
 
 
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     """Similarity search and k-NN classification of clips through an interval index.
 
-    Fit computes each clip's SVD feature vector (:class:`SVDFeatureExtractor`
-    with ``n_components=n_levels``) and inserts it into an interval tree with one
+    Fit computes each clip's SVD feature vector (the projection of
+    :func:`~skmotion.decomposition.fit_svd_projection`, with ``n_levels_``
+    components) and inserts it into an interval tree with one
     level per component (Li & Prabhakaran). ``delta_i``, how far apart component
     ``i`` of two clips with the same label can be, is learned from ``y``; level
     ``i`` cuts the component's range into entries of width ``epsilon * delta_i``
@@ -99,12 +48,17 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     then ranked by the similarity :func:`psi` (distance ``1 - psi``).
 
     ``X`` may also be a 2-D array of feature vectors: the tree indexes its first
-    ``n_levels`` columns and candidates are ranked by Euclidean distance.
+    ``n_levels_`` columns and candidates are ranked by Euclidean distance.
 
     Parameters
     ----------
-    n_levels : int, default=7
-        Levels of the tree, i.e. feature components indexed.
+    n_levels : int or None, default=None
+        Levels of the tree, i.e. feature components indexed. None means
+        ``features.n_components`` when that is set, else 7 capped at what the
+        data allows (the feature columns, or for clips the number of training
+        clips and the composite vector's length: 6 on 6-channel clips with
+        ``weighting="first"``); ``n_levels_`` holds the value used. An explicit
+        value the data cannot give is an error naming the limit.
     epsilon : float, default=1.0
         Entry interval factor: entry width and covering radius are
         ``epsilon * delta_i``. With ``epsilon >= 1`` and ``delta_quantile=1``
@@ -121,10 +75,12 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     k : int, default=6
         Eigenvectors compared by :func:`psi` (clips only).
     features : SVDFeatureExtractor, default=None
-        The feature extractor (cloned, with ``n_components`` set to
-        ``n_levels``); None means ``SVDFeatureExtractor(weighting="first")``.
-        Use ``SVDFeatureExtractor(weighting="first_two")`` for the weighted
-        first two singular vectors.
+        Its ``weighting`` chooses the feature vectors; None means
+        ``SVDFeatureExtractor(weighting="first")``. Use
+        ``SVDFeatureExtractor(weighting="first_two")`` for the weighted first
+        two singular vectors. The tree has one level per feature component, so
+        its ``n_components`` (when not None) sets the number of levels; giving
+        both ``n_levels`` and a different ``features.n_components`` is an error.
     n_jobs : int, default=None
         Number of jobs for the SVDs and the ranking; results do not depend on it.
 
@@ -132,12 +88,16 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     ----------
     classes_ : ndarray of shape (n_classes,)
         Class labels.
-    delta_ : ndarray of shape (n_levels,)
+    n_levels_ : int
+        Levels of the tree (= feature components indexed).
+    delta_ : ndarray of shape (n_levels_,)
         The learned ``delta_i``.
     index_ : IntervalIndex
         The tree; stored clip ``j`` has id ``j``.
+    projection_ : SVDProjection or None
+        The fitted feature projection (None for feature-vector input).
     feature_extractor_ : SVDFeatureExtractor or None
-        The fitted extractor (None for feature-vector input).
+        An extractor applying ``projection_`` (None for feature-vector input).
     input_kind_ : {"clips", "table"}
         What fit was given.
     effective_metric_ : {"psi", "euclidean"}
@@ -158,6 +118,11 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     Notes
     -----
+    Every clip is divided by its largest absolute value before its SVD: the
+    singular vectors, their energy shares and so psi and the feature vectors do
+    not depend on a clip's scale, and clips of any finite magnitude (1e-300 to
+    1e300) are described alike.
+
     A query whose leaf holds fewer than ``n_neighbors`` clips is ranked against
     all stored clips instead, so :meth:`kneighbors` always returns
     ``n_neighbors`` neighbours; :meth:`candidates` shows the pruned sets as they
@@ -177,8 +142,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     >>> data = make_motions(n_clips_per_class=6, random_state=0)
     >>> clips = [c[:, 6:] for c in data.clips]  # joint angles without the root
     >>> index = IntervalIndexNeighbors(n_levels=5, epsilon=1.0).fit(clips, data.target)
-    >>> index.n_samples_fit_, len(index.candidates(clips[:3]))
-    (42, 3)
+    >>> index.n_samples_fit_, index.n_levels_, len(index.candidates(clips[:3]))
+    (42, 5, 3)
     >>> distances, neighbours = index.kneighbors(n_neighbors=2)
     >>> neighbours.shape
     (42, 2)
@@ -187,7 +152,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     """
 
     _parameter_constraints = {
-        "n_levels": [Interval(Integral, 1, None, closed="left")],
+        "n_levels": [Interval(Integral, 1, None, closed="left"), None],
         "epsilon": [Interval(Real, 0, None, closed="neither")],
         "max_entries": [Interval(Integral, 1, None, closed="left")],
         "delta_quantile": [Interval(Real, 0, 1, closed="right")],
@@ -200,7 +165,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     def __init__(
         self,
-        n_levels=7,
+        n_levels=None,
         *,
         epsilon=1.0,
         max_entries=64,
@@ -227,31 +192,66 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     # -- input -------------------------------------------------------------------
 
     def _describe(self, X, *, reset):
-        """Validate ``X`` once; return (tree features, ranking data)."""
+        """Validate ``X`` once; return (feature vectors, ranking data)."""
+        kind = input_kind(X)
         if reset:
-            self.input_kind_ = "table" if _is_table(X) else "clips"
-        elif ("table" if _is_table(X) else "clips") != self.input_kind_:
+            self.input_kind_ = kind
+        elif kind != self.input_kind_:
             expected = "a 2-D array of feature vectors" if self.input_kind_ == "table" else "clips"
             raise ValueError(
                 f"X: {type(self).__name__} was fitted on {expected}; pass the same kind."
             )
         if self.input_kind_ == "table":
             table = validate_data(self, X, reset=reset, dtype=np.float64)
-            return table, table
+            if reset:
+                self.n_levels_ = self._resolve_levels(table.shape[1], "feature(s) of X")
+            return table[:, : self.n_levels_], table
         clips = check_clips(X, estimator=self, reset=reset)
-        extractor = self._extractor() if reset else self.feature_extractor_
-        n_vectors = max(min(self.k, clips.n_channels), _N_VECTORS[extractor.weighting])
-        eigenvalues, vectors = clip_spectra(clips, n_vectors, n_jobs=self.n_jobs)
+        weighting = self._weighting()
+        n_vectors = max(min(self.k, clips.n_channels), N_VECTORS[weighting])
+        spectra = clip_spectra(clips, n_vectors, n_jobs=self.n_jobs)
         if reset:
-            extractor._fit_spectra(eigenvalues, vectors)
-            extractor.n_features_in_ = clips.n_channels
-            self.feature_extractor_ = extractor
-        features = extractor._transform_spectra(eigenvalues, vectors)
-        return features, signatures_from_spectra(eigenvalues, vectors, self.k)
+            limit = max_svd_components(len(clips), clips.n_channels, weighting)
+            self.n_levels_ = self._resolve_levels(
+                limit,
+                f"SVD feature components the clips allow (at most the {len(clips)} training "
+                f"clips and the composite vector's {N_VECTORS[weighting]} x "
+                f"{clips.n_channels} channels)",
+            )
+            self.projection_ = fit_svd_projection(*spectra, self.n_levels_, weighting)
+        return svd_project(self.projection_, *spectra), signatures_from_spectra(*spectra, self.k)
 
-    def _extractor(self):
-        base = SVDFeatureExtractor() if self.features is None else self.features
-        return clone(base).set_params(n_components=self.n_levels, n_jobs=self.n_jobs)
+    def _weighting(self):
+        return "first" if self.features is None else self.features.weighting
+
+    def _resolve_levels(self, limit, what):
+        """``n_levels_``: the levels asked for, or the capped default (see ``n_levels``)."""
+        from_features = None if self.features is None else self.features.n_components
+        if self.n_levels is not None and from_features not in (None, self.n_levels):
+            raise ValueError(
+                f"n_levels={self.n_levels} and features.n_components={from_features} disagree: "
+                "the tree has one level per feature component. Set one of them (or both equal)."
+            )
+        asked = self.n_levels if self.n_levels is not None else from_features
+        if asked is None:
+            return min(_DEFAULT_LEVELS, limit)
+        if asked > limit:
+            raise ValueError(
+                f"n_levels={asked} is more than the {limit} {what}: the tree has one level "
+                f"per feature component. "
+                f"Pass n_levels={limit} or fewer, or n_levels=None for min(7, {limit})."
+            )
+        return int(asked)
+
+    @property
+    def feature_extractor_(self):
+        """A fitted :class:`SVDFeatureExtractor` giving this index's feature vectors."""
+        check_is_fitted(self)
+        if self.input_kind_ == "table":
+            return None
+        return SVDFeatureExtractor.from_projection(
+            self.projection_, self.n_features_in_, n_jobs=self.n_jobs
+        )
 
     def _check_labels(self, y, n, *, known=False):
         # Labels that must be among classes_ (known=True) are checked against
@@ -287,59 +287,51 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         return self._fit(X, y)
 
     def _fit(self, X, y, classes=None):
-        features, ranking = self._describe(X, reset=True)
-        y = self._check_labels(y, len(features))
-        if self.input_kind_ == "table" and features.shape[1] < self.n_levels:
-            raise ValueError(
-                f"n_levels={self.n_levels} needs feature vectors with at least that many "
-                f"columns; X has {features.shape[1]} feature(s)."
-            )
+        tree_features, ranking = self._describe(X, reset=True)
+        y = self._check_labels(y, len(tree_features))
+        if self.input_kind_ == "table":
+            self.projection_ = None
         self.classes_ = np.unique(y if classes is None else classes)
         self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
-        tree_features = features[:, : self.n_levels]
         self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
         radius = self.epsilon * self.delta_
         low, high = tree_features.min(axis=0), tree_features.max(axis=0)
         edges = [
-            entry_edges(low[i], high[i], radius[i], self.max_entries) for i in range(self.n_levels)
+            entry_edges(low[i], high[i], radius[i], self.max_entries) for i in range(self.n_levels_)
         ]
         self.index_ = IntervalIndex(edges, radius)
         self.index_.insert(tree_features)
         self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
-        self.n_samples_fit_ = 0
-        self._buffers = None
+        names = ("weights", "vectors") if self.effective_metric_ == "psi" else ("table",)
+        self._stored = GrowableStore(("tree", "encoded", "labels") + names)
         self._store(tree_features, ranking, encoded)
         return self
 
     def _store(self, tree_features, ranking, encoded):
         """Append clips' tree features, ranking data and labels to the stored ones."""
-        labels = self.classes_[encoded]
-        new = (
-            tree_features,
-            encoded,
-            labels,
-            *(ranking if isinstance(ranking, tuple) else (ranking,)),
+        ranking = ranking if isinstance(ranking, tuple) else (ranking,)
+        parts = dict(zip(self._stored.names[3:], ranking))
+        self._stored.append(
+            tree=tree_features, encoded=encoded, labels=self.classes_[encoded], **parts
         )
-        old = self._buffers or (None,) * len(new)
-        n = self.n_samples_fit_
-        self._buffers = tuple(_extend(b, n, a) for b, a in zip(old, new))
-        self.n_samples_fit_ = n + len(tree_features)
-        self.labels_ = self._buffers[2][: self.n_samples_fit_]  # a view: O(1) per insertion
+        self.n_samples_fit_ = len(self._stored)
+        self.labels_ = self._stored["labels"]  # a view: O(1) per insertion
 
     @property
     def _tree_features(self):
-        return self._buffers[0][: self.n_samples_fit_]
+        return self._stored["tree"]
 
     @property
     def _encoded(self):
-        return self._buffers[1][: self.n_samples_fit_]
+        return self._stored["encoded"]
 
     @property
     def _ranking(self):
         """Signatures (weights, vectors) for psi, or the feature vectors."""
-        parts = tuple(b[: self.n_samples_fit_] for b in self._buffers[3:])
-        return parts if self.effective_metric_ == "psi" else parts[0]
+        if self.effective_metric_ == "psi":
+            return self._stored["weights"], self._stored["vectors"]
+        return self._stored["table"]
 
     def insert(self, X, y):
         """Add clips to the fitted index, without rebuilding it.
@@ -359,11 +351,10 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             The index, now holding the new clips.
         """
         check_is_fitted(self)
-        features, ranking = self._describe(X, reset=False)
-        y = self._check_labels(y, len(features), known=True)
+        tree_features, ranking = self._describe(X, reset=False)
+        y = self._check_labels(y, len(tree_features), known=True)
         self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
-        tree_features = features[:, : self.n_levels]
         self.index_.insert(tree_features)
         self._store(tree_features, ranking, encoded)
         return self
@@ -410,8 +401,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         check_is_fitted(self)
         if X is None:
             return self._tree_features, self._ranking, np.arange(self.n_samples_fit_)
-        features, ranking = self._describe(X, reset=False)
-        return features[:, : self.n_levels], ranking, None
+        tree_features, ranking = self._describe(X, reset=False)
+        return tree_features, ranking, None
 
     def candidates(self, X=None):
         """The pruned candidate set of each query: ids of the clips in its leaf.
@@ -450,16 +441,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         distances = self._distances(ranking, rows, columns)
         if self_ids is not None:
             distances[columns[None, :] == self_ids[rows][:, None]] = np.inf
-        if columns.size > 4 * n_neighbors:
-            part = np.argpartition(distances, n_neighbors - 1, axis=1)[:, :n_neighbors]
-            part.sort(axis=1)  # equal distances: the lower id first
-        else:
-            part = np.broadcast_to(np.arange(columns.size), distances.shape)
-        order = np.argsort(np.take_along_axis(distances, part, axis=1), axis=1, kind="stable")[
-            :, :n_neighbors
-        ]
-        chosen = np.take_along_axis(part, order, axis=1)
-        return rows, np.take_along_axis(distances, chosen, axis=1), columns[chosen]
+        chosen, nearest = smallest_k(distances, n_neighbors)
+        return nearest, columns[chosen]
 
     def kneighbors(self, X=None, n_neighbors=None, return_distance=True):
         """The nearest stored clips of each query, among its candidates.
@@ -489,24 +472,13 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
                 f"n_neighbors must be an integer from 1 to {available} (the stored clips"
                 f"{' other than the query' if self_ids is not None else ''}); got {n_neighbors!r}."
             )
-        leaves = self.index_.leaf_of(features)
-        order = np.argsort(leaves, kind="stable")
-        bounds = np.flatnonzero(np.r_[True, leaves[order][1:] != leaves[order][:-1], True])
-        groups = [(leaves[order[a]], order[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
-        tasks = [groups[i : i + _LEAVES_PER_TASK] for i in range(0, len(groups), _LEAVES_PER_TASK)]
-
-        def rank(task):
-            return [
-                self._rank_leaf(leaf, rows, ranking, self_ids, n_neighbors) for leaf, rows in task
-            ]
-
-        distances = np.empty((len(features), n_neighbors))
-        indices = np.empty((len(features), n_neighbors), dtype=np.intp)
-        with small_blas():
-            ranked = parallel_map(rank, tasks, n_jobs=self.n_jobs)
-        for part in ranked:
-            for rows, dist, ind in part:
-                distances[rows], indices[rows] = dist, ind
+        distances, indices = nearest_in_leaves(
+            self.index_.leaf_of(features),
+            lambda leaf, rows: self._rank_leaf(leaf, rows, ranking, self_ids, n_neighbors),
+            n_neighbors,
+            leaves_per_task=_LEAVES_PER_TASK,
+            n_jobs=self.n_jobs,
+        )
         return (distances, indices) if return_distance else indices
 
     def predict_proba(self, X):

@@ -21,7 +21,8 @@ def test_matches_the_svd_of_every_clip(seed, n_channels, n_vectors):
     n_vectors = min(n_vectors, n_channels)
     eigenvalues, vectors = clip_spectra(clips, n_vectors)
     for clip, values, vecs in zip(clips, eigenvalues, vectors):
-        _, s, vt = np.linalg.svd(clip)
+        # Each clip is decomposed divided by its largest absolute value.
+        _, s, vt = np.linalg.svd(clip / np.abs(clip).max())
         rank = int(np.sum(s > s[0] * 1e-10))
         expected = np.zeros(n_channels)
         expected[:rank] = s[:rank] ** 2
@@ -35,6 +36,19 @@ def test_matches_the_svd_of_every_clip(seed, n_channels, n_vectors):
                 continue  # a repeated singular value: the vector is not unique
             # Unit vectors equal up to sign.
             np.testing.assert_allclose(abs(vecs[:, i] @ vt[i]), 1.0, atol=1e-7)
+
+
+@settings(max_examples=20, deadline=None)
+@given(st.integers(0, 10_000), st.sampled_from([1e-300, 1e-150, 1e150, 1e300]))
+def test_spectra_do_not_depend_on_the_clips_scale(seed, scale):
+    # x1e300 would overflow a Gram matrix (1e600), x1e-300 underflow it: the
+    # spectra of the scaled clips equal those of the clips themselves.
+    rng = np.random.default_rng(seed)
+    clips = [rng.normal(size=(n, 5)) for n in (3, 20, 20)]
+    values, vectors = clip_spectra(clips, 3)
+    big_values, big_vectors = clip_spectra([c * scale for c in clips], 3)
+    np.testing.assert_allclose(big_values, values, rtol=1e-10, atol=1e-14)
+    np.testing.assert_allclose(np.abs(big_vectors), np.abs(vectors), atol=1e-10)
 
 
 def test_chunks_and_jobs_give_the_same_spectra():
