@@ -17,9 +17,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 RESULTS = Path(__file__).resolve().parent / "results"
 # SKMOTION_SHARED_DATA points elsewhere (as for the tests), e.g. from a git worktree.
-SHARED_DATA = Path(
-    os.environ.get("SKMOTION_SHARED_DATA", Path(__file__).resolve().parents[1].parent / "shared" / "data")
-)
+_DEFAULT_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", _DEFAULT_DATA))
 
 
 def time_call(func, *, repeats=5, warmup=1):

@@ -245,7 +245,7 @@ def test_grid_search_over_epsilon_and_n_levels_with_the_scorers(repeated):
         cv=GroupKFold(4),
     ).fit(clips, target, groups=groups)
     results = search.cv_results_
-    for i, params in enumerate(results["params"]):
+    for i in range(len(results["params"])):
         pruning, found = results["mean_test_pruning"][i], results["mean_test_recall"][i]
         assert 0 <= pruning <= 1 and 0 <= found <= 1
     # epsilon widens the entries: more candidates, less pruning, more recall.
