@@ -34,7 +34,7 @@ def time_call(func, *, repeats=5, warmup=1):
 
 
 def interleaved(funcs, rounds):
-    """Median seconds of each function, timed in alternation so that they share the machine's load."""
+    """Median seconds of each function, timed in alternation (they share the machine's load)."""
     for func in funcs:
         func()  # warm-up
     times = [[] for _ in funcs]
