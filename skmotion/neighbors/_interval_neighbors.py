@@ -5,6 +5,7 @@ from numbers import Integral, Real
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.metrics.pairwise import euclidean_distances
+from sklearn.utils import check_random_state
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, column_or_1d, validate_data
 
@@ -21,9 +22,9 @@ from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
 from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_k
 from skmotion.neighbors._store import GrowableStore
-from skmotion.neighbors._widths import learn_delta
+from skmotion.neighbors._widths import label_pairs, learn_delta, learn_radius, psi_pairs
 from skmotion.utils._clips import check_clips
-from skmotion.utils._sklearn_compat import Interval, _fit_context
+from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["IntervalIndexNeighbors", "learn_delta"]
 
@@ -31,6 +32,11 @@ __all__ = ["IntervalIndexNeighbors", "learn_delta"]
 _LEAVES_PER_TASK = 32
 # Levels of the tree when neither n_levels nor features.n_components is given.
 _DEFAULT_LEVELS = 7
+# The recall the entry widths are learned for when neither rule is given.
+_DEFAULT_RECALL = 0.99
+# Similar pairs target_recall learns from (drawn beyond this), and psi anchors.
+_MAX_PAIRS = 200_000
+_PSI_ANCHORS = 2_000
 
 
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -59,11 +65,21 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         clips and the composite vector's length: 6 on 6-channel clips with
         ``weighting="first"``); ``n_levels_`` holds the value used. An explicit
         value the data cannot give is an error naming the limit.
-    epsilon : float, default=1.0
-        Entry interval factor: entry width and covering radius are
+    target_recall : float in (0, 1] or None, default=None
+        Learn each level's radius (and entry width) so that this share of the
+        training clips' similar pairs survives the tree, pruning as much as
+        possible (see Notes). None means 0.99 unless ``epsilon`` is given.
+    epsilon : float or None, default=None
+        The paper's rule instead: entry width and covering radius are
         ``epsilon * delta_i``. With ``epsilon >= 1`` and ``delta_quantile=1``
         every stored clip with the query's label is a candidate when the query
-        is a stored clip (recall 1 by construction).
+        is a stored clip (recall 1 by construction). Giving both ``epsilon``
+        and ``target_recall`` is an error.
+    similar : {"labels", "psi"}, default="labels"
+        Which training pairs ``target_recall`` keeps: clips with the same label,
+        or each clip and its nearest other clip by psi (for clips whose labels
+        are classes rather than repetitions: then the pairs are the repetitions
+        psi finds, and the recall is that of the exact psi 1-NN).
     max_entries : int, default=64
         The most entries a node may have; wider entries are used when capped.
     delta_quantile : float, default=1.0
@@ -83,6 +99,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         both ``n_levels`` and a different ``features.n_components`` is an error.
     n_jobs : int, default=None
         Number of jobs for the SVDs and the ranking; results do not depend on it.
+    random_state : int, RandomState instance or None, default=None
+        Draws the pairs ``target_recall`` learns from when there are more than
+        200,000 (and the anchors of ``similar="psi"``, at most 2,000).
 
     Attributes
     ----------
@@ -91,7 +110,15 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     n_levels_ : int
         Levels of the tree (= feature components indexed).
     delta_ : ndarray of shape (n_levels_,)
-        The learned ``delta_i``.
+        The learned ``delta_i`` (the paper's rule).
+    radius_ : ndarray of shape (n_levels_,)
+        Covering radius (and entry width) of each level: ``epsilon * delta_``,
+        or learned for ``target_recall``.
+    width_rule_ : {"target_recall", "epsilon"}
+        Which rule set ``radius_``.
+    training_survival_ : float
+        With ``target_recall``: the share of random pairs of training clips
+        that survive the tree (1 - the pruning expected on such pairs).
     index_ : IntervalIndex
         The tree; stored clip ``j`` has id ``j``.
     projection_ : SVDProjection or None
@@ -118,6 +145,18 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     Notes
     -----
+    Entry widths. ``target_recall`` (the default, 0.99) learns the radii from
+    the training clips' similar pairs (same label, or psi nearest neighbours):
+    for a few shapes of the radii (per-level quantiles of the pairs'
+    component distances) the common scale is the smallest at which that share
+    of the pairs survives the tree (computed exactly, with the entries the tree
+    will have), and the shape that lets the fewest random training pairs
+    through is kept (``training_survival_``). The held-out recall is close to,
+    not guaranteed at, the target. ``epsilon`` gives the paper's rule instead.
+    Measured on held-out queries (``benchmarks/bench_neighbors_pruning.py``),
+    the learned widths prune more than ``epsilon=1.0`` at the same recall on
+    every development set.
+
     Every clip is divided by its largest absolute value before its SVD: the
     singular vectors, their energy shares and so psi and the feature vectors do
     not depend on a clip's scale, and clips of any finite magnitude (1e-300 to
@@ -153,13 +192,16 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     _parameter_constraints = {
         "n_levels": [Interval(Integral, 1, None, closed="left"), None],
-        "epsilon": [Interval(Real, 0, None, closed="neither")],
+        "target_recall": [Interval(Real, 0, 1, closed="right"), None],
+        "epsilon": [Interval(Real, 0, None, closed="neither"), None],
+        "similar": [StrOptions({"labels", "psi"})],
         "max_entries": [Interval(Integral, 1, None, closed="left")],
         "delta_quantile": [Interval(Real, 0, 1, closed="right")],
         "n_neighbors": [Interval(Integral, 1, None, closed="left")],
         "k": [Interval(Integral, 1, None, closed="left")],
         "features": [SVDFeatureExtractor, None],
         "n_jobs": [Integral, None],
+        "random_state": ["random_state"],
     }
     _motion_tags = MotionTags(output_kind="labels")
 
@@ -167,22 +209,28 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self,
         n_levels=None,
         *,
-        epsilon=1.0,
+        target_recall=None,
+        epsilon=None,
+        similar="labels",
         max_entries=64,
         delta_quantile=1.0,
         n_neighbors=1,
         k=6,
         features=None,
         n_jobs=None,
+        random_state=None,
     ):
         self.n_levels = n_levels
+        self.target_recall = target_recall
         self.epsilon = epsilon
+        self.similar = similar
         self.max_entries = max_entries
         self.delta_quantile = delta_quantile
         self.n_neighbors = n_neighbors
         self.k = k
         self.features = features
         self.n_jobs = n_jobs
+        self.random_state = random_state
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
@@ -291,22 +339,47 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         y = self._check_labels(y, len(tree_features))
         if self.input_kind_ == "table":
             self.projection_ = None
+        self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
         self.classes_ = np.unique(y if classes is None else classes)
         self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
         self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
-        radius = self.epsilon * self.delta_
+        radius = self.radius_ = self._radius(tree_features, encoded, ranking)
         low, high = tree_features.min(axis=0), tree_features.max(axis=0)
         edges = [
             entry_edges(low[i], high[i], radius[i], self.max_entries) for i in range(self.n_levels_)
         ]
         self.index_ = IntervalIndex(edges, radius)
         self.index_.insert(tree_features)
-        self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
         names = ("weights", "vectors") if self.effective_metric_ == "psi" else ("table",)
         self._stored = GrowableStore(("tree", "encoded", "labels") + names)
         self._store(tree_features, ranking, encoded)
         return self
+
+    def _radius(self, tree_features, encoded, ranking):
+        """Each level's radius by the paper's rule or learned for the recall asked."""
+        if self.epsilon is not None and self.target_recall is not None:
+            raise ValueError(
+                f"epsilon={self.epsilon} and target_recall={self.target_recall}: give one rule "
+                "for the entry widths (epsilon: the paper's epsilon * delta_i; target_recall: "
+                "learned from the similar pairs)."
+            )
+        if self.epsilon is not None:
+            self.width_rule_ = "epsilon"
+            return self.epsilon * self.delta_
+        self.width_rule_ = "target_recall"
+        rng = check_random_state(self.random_state)
+        if self.similar == "psi":
+            if self.effective_metric_ != "psi":
+                raise ValueError('similar="psi" needs clips; X is a table of feature vectors.')
+            pairs = psi_pairs(ranking, _PSI_ANCHORS, rng, n_jobs=self.n_jobs)
+        else:
+            pairs = label_pairs(encoded, _MAX_PAIRS, rng)
+        target = _DEFAULT_RECALL if self.target_recall is None else self.target_recall
+        radius, self.training_survival_ = learn_radius(
+            tree_features, *pairs, target, rng, max_entries=self.max_entries
+        )
+        return radius
 
     def _store(self, tree_features, ranking, encoded):
         """Append clips' tree features, ranking data and labels to the stored ones."""
