@@ -27,7 +27,6 @@ from _common import RESULTS, SHARED_DATA, write_results  # noqa: E402
 from _motion_data import search_datasets  # noqa: E402
 
 from skmotion.datasets import load_uea  # noqa: E402
-
 from skmotion.decomposition import SVDFeatureExtractor  # noqa: E402
 from skmotion.metrics import pruning_efficiency, recall  # noqa: E402
 from skmotion.neighbors import IntervalIndexNeighbors  # noqa: E402

@@ -36,6 +36,11 @@ _CONTROLLER = None
 
 # Clips per task: fixed, so the tasks (and so the results) do not depend on n_jobs.
 _CHUNK = 512
+# Subspace iteration: residual tolerance (relative to the largest eigenvalue),
+# steps between convergence checks, and the steps before a full eigh takes over.
+_TOLERANCE = 1e-9
+_CHECK = 4
+_MAX_STEPS = 24
 
 
 def _rank_tolerance(eigenvalues):
@@ -56,26 +61,78 @@ def _unit_scale(clip):
     return clip / peak if peak > 0 else clip
 
 
-def _spectra_of_chunk(chunk, n_vectors):
+def _leading_eigh(grams, n_vectors):
+    """Leading eigenpairs of stacked symmetric matrices by subspace iteration.
+
+    A block of ``n_vectors + 4`` vectors is multiplied by the matrices and
+    re-orthonormalised (one batched QR) a few times, then a Rayleigh-Ritz step
+    (a batched eigh of ``block x block`` matrices) gives the pairs. Every
+    ``_CHECK`` steps the residuals ``|G v - lambda v|`` are checked against
+    ``_TOLERANCE * lambda_1``; matrices not converged after ``_MAX_STEPS``
+    (close eigenvalues, slow convergence) get a full ``eigh``, so the answer is
+    always within the tolerance. Returns values (decreasing) and vectors.
+    """
+    m, d, _ = grams.shape
+    block = min(d, n_vectors + 4)
+    if 2 * block >= d:  # small matrices: the full decomposition costs no more
+        values, vectors = np.linalg.eigh(grams)
+        return values[:, ::-1][:, :n_vectors], vectors[:, :, ::-1][:, :, :n_vectors]
+    start = np.random.default_rng(0).standard_normal((d, block))  # fixed: reproducible
+    basis = np.linalg.qr(grams @ start)[0]
+    values = np.zeros((m, n_vectors))
+    vectors = np.zeros((m, d, n_vectors))
+    todo = np.arange(m)
+    for step in range(2, _MAX_STEPS + 1, 2):
+        # Two products per orthonormalisation: the QR costs more than a product,
+        # and the Gram matrices of unit-scaled clips keep G^2 X well within range.
+        active = grams[todo]
+        basis = np.linalg.qr(active @ (active @ basis))[0]
+        if step % _CHECK and step < _MAX_STEPS:
+            continue
+        product = active @ basis
+        ritz, rotation = np.linalg.eigh(np.swapaxes(basis, 1, 2) @ product)
+        rotation = rotation[:, :, ::-1][:, :, :n_vectors]
+        ritz = ritz[:, ::-1][:, :n_vectors]
+        candidate = basis @ rotation
+        residual = np.linalg.norm(product @ rotation - candidate * ritz[:, None, :], axis=1)
+        done = (residual <= _TOLERANCE * np.abs(ritz[:, :1])).all(axis=1)
+        values[todo[done]], vectors[todo[done]] = ritz[done], candidate[done]
+        todo, basis = todo[~done], basis[~done]
+        if not len(todo):
+            return values, vectors
+    exact_values, exact_vectors = np.linalg.eigh(grams[todo])
+    values[todo] = exact_values[:, ::-1][:, :n_vectors]
+    vectors[todo] = exact_vectors[:, :, ::-1][:, :, :n_vectors]
+    return values, vectors
+
+
+def _spectra_of_chunk(chunk, n_vectors, method):
     n = chunk[0].shape[1]
     eigenvalues = np.zeros((len(chunk), n))
     vectors = np.zeros((len(chunk), n, n_vectors))
     # The smaller Gram matrix of each clip: A^T A (channels x channels), or A A^T
-    # (frames x frames) for a clip with fewer frames than channels. Clips whose
-    # Gram matrices have one size are decomposed in one batched call.
-    sizes = np.array([min(len(c), n) for c in chunk])
-    for size in np.unique(sizes):
-        rows = np.flatnonzero(sizes == size)
-        clips = [_unit_scale(chunk[i]) for i in rows]
-        tall = size == n
-        values, vecs = np.linalg.eigh(np.stack([c.T @ c if tall else c @ c.T for c in clips]))
-        values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
+    # (frames x frames) for a clip with fewer frames than channels. Clips of one
+    # length are stacked: their Gram matrices come from one batched product and
+    # are decomposed in one batched call.
+    lengths = np.array([len(c) for c in chunk])
+    for length in np.unique(lengths):
+        rows = np.flatnonzero(lengths == length)
+        clips = np.stack([np.asarray(chunk[i], dtype=np.float64) for i in rows])
+        peak = np.abs(clips).max(axis=(1, 2), keepdims=True)
+        clips = clips / np.where(peak > 0, peak, 1.0)  # see _unit_scale
+        tall = length >= n
+        grams = np.swapaxes(clips, 1, 2) @ clips if tall else clips @ np.swapaxes(clips, 1, 2)
+        if method == "iterative":
+            values, vecs = _leading_eigh(grams, min(n_vectors, grams.shape[1]))
+        else:
+            values, vecs = np.linalg.eigh(grams)
+            values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
         if not tall:
             # Right singular vectors from the left ones: v = A^T w / |A^T w|.
-            vecs = np.stack([c.T @ w for c, w in zip(clips, vecs)])
+            vecs = np.swapaxes(clips, 1, 2) @ vecs
             norms = np.linalg.norm(vecs, axis=1, keepdims=True)
             vecs = np.divide(vecs, norms, out=np.zeros_like(vecs), where=norms > 0)
-        eigenvalues[rows, :size] = values
+        eigenvalues[rows, : values.shape[1]] = values
         vectors[rows, :, : vecs.shape[2]] = vecs
     eigenvalues = np.clip(eigenvalues, 0.0, None)
     # Directions beyond a clip's rank are undefined: make them zero vectors, so
@@ -86,7 +143,7 @@ def _spectra_of_chunk(chunk, n_vectors):
     return eigenvalues, vectors
 
 
-def clip_spectra(clips, n_vectors, *, n_jobs=None):
+def clip_spectra(clips, n_vectors, *, method="exact", n_jobs=None):
     """Squared singular values and leading right singular vectors of each clip.
 
     Parameters
@@ -95,6 +152,11 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
         Validated clips (see :func:`skmotion.utils.check_clips`).
     n_vectors : int
         How many leading right singular vectors to return (at most ``n_channels``).
+    method : {"exact", "iterative"}, default="exact"
+        ``"exact"``: a full batched ``eigh`` of each Gram matrix, all eigenvalues.
+        ``"iterative"``: subspace iteration for the ``n_vectors`` leading pairs
+        only, each within ``1e-9 * lambda_1`` in residual (a full ``eigh``
+        otherwise); the eigenvalues beyond ``n_vectors`` are then returned as 0.
     n_jobs : int, default=None
         Number of jobs over chunks of clips; results do not depend on it.
 
@@ -125,6 +187,6 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     chunks = [clips[i : i + _CHUNK] for i in range(0, len(clips), _CHUNK)]
     with small_blas():
         parts = parallel_map(
-            lambda chunk: _spectra_of_chunk(chunk, n_vectors), chunks, n_jobs=n_jobs
+            lambda chunk: _spectra_of_chunk(chunk, n_vectors, method), chunks, n_jobs=n_jobs
         )
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])

@@ -257,7 +257,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         clips = check_clips(X, estimator=self, reset=reset)
         weighting = self._weighting()
         n_vectors = max(min(self.k, clips.n_channels), N_VECTORS[weighting])
-        spectra = clip_spectra(clips, n_vectors, n_jobs=self.n_jobs)
+        # Only the leading pairs are needed unless "first_two" weighs by all singular values.
+        method = "iterative" if weighting == "first" else "exact"
+        spectra = clip_spectra(clips, n_vectors, method=method, n_jobs=self.n_jobs)
         if reset:
             limit = max_svd_components(len(clips), clips.n_channels, weighting)
             self.n_levels_ = self._resolve_levels(

@@ -62,3 +62,25 @@ def test_chunks_and_jobs_give_the_same_spectra():
     alone = clip_spectra(clips[700:701], 3)
     np.testing.assert_array_equal(alone[0][0], one[0][700])
     np.testing.assert_array_equal(alone[1][0], one[1][700])
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 10_000), st.sampled_from([(40, 60), (120, 30), (25, 25)]))
+def test_iterative_leading_pairs_match_the_full_svd(seed, shape):
+    # Motion-like spectra (decaying) and one clip with two equal singular values.
+    rng = np.random.default_rng(seed)
+    n_frames, n_channels = shape
+    decay = np.exp(-np.arange(n_channels) / rng.uniform(2, 8))
+    clips = [rng.normal(size=shape) * decay for _ in range(5)]
+    equal = rng.normal(size=shape) * decay
+    equal[:, 1] = equal[:, 0] * 0  # rank change: a zero column
+    clips.append(equal)
+    values, vectors = clip_spectra(clips, 6, method="iterative")
+    for clip, vals, vecs in zip(clips, values, vectors):
+        _, s, vt = np.linalg.svd(clip / np.abs(clip).max())
+        np.testing.assert_allclose(vals[:6], s[:6] ** 2, rtol=1e-8, atol=1e-12 * s[0] ** 2)
+        for i in range(6):
+            gaps = np.abs(s[i] ** 2 - np.delete(s**2, i))
+            if gaps.min() < 1e-3 * s[0] ** 2:
+                continue  # nearly equal singular values: the vector is barely defined
+            np.testing.assert_allclose(abs(vecs[:, i] @ vt[i]), 1.0, atol=1e-6)
