@@ -35,7 +35,7 @@ _DEFAULT_LEVELS = 7
 # The recall the entry widths are learned for when neither rule is given.
 _DEFAULT_RECALL = 0.99
 # Similar pairs target_recall learns from (drawn beyond this), and psi anchors.
-_MAX_PAIRS = 200_000
+_MAX_PAIRS = 50_000
 _PSI_ANCHORS = 2_000
 
 
@@ -80,6 +80,11 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         or each clip and its nearest other clip by psi (for clips whose labels
         are classes rather than repetitions: then the pairs are the repetitions
         psi finds, and the recall is that of the exact psi 1-NN).
+    width_factor : float, default=1.0
+        Entry width over covering radius. 1 is the paper's layout; wider
+        entries (2) put each clip into fewer leaves (about ``2**n_levels``
+        instead of ``3**n_levels``: less memory, faster insertion) at some cost
+        in pruning, which ``target_recall`` takes into account.
     max_entries : int, default=64
         The most entries a node may have; wider entries are used when capped.
     delta_quantile : float, default=1.0
@@ -101,7 +106,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         Number of jobs for the SVDs and the ranking; results do not depend on it.
     random_state : int, RandomState instance or None, default=None
         Draws the pairs ``target_recall`` learns from when there are more than
-        200,000 (and the anchors of ``similar="psi"``, at most 2,000).
+        50,000 (and the anchors of ``similar="psi"``, at most 2,000).
 
     Attributes
     ----------
@@ -195,6 +200,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         "target_recall": [Interval(Real, 0, 1, closed="right"), None],
         "epsilon": [Interval(Real, 0, None, closed="neither"), None],
         "similar": [StrOptions({"labels", "psi"})],
+        "width_factor": [Interval(Real, 0, None, closed="neither")],
         "max_entries": [Interval(Integral, 1, None, closed="left")],
         "delta_quantile": [Interval(Real, 0, 1, closed="right")],
         "n_neighbors": [Interval(Integral, 1, None, closed="left")],
@@ -212,6 +218,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         target_recall=None,
         epsilon=None,
         similar="labels",
+        width_factor=1.0,
         max_entries=64,
         delta_quantile=1.0,
         n_neighbors=1,
@@ -224,6 +231,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self.target_recall = target_recall
         self.epsilon = epsilon
         self.similar = similar
+        self.width_factor = width_factor
         self.max_entries = max_entries
         self.delta_quantile = delta_quantile
         self.n_neighbors = n_neighbors
@@ -349,7 +357,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         radius = self.radius_ = self._radius(tree_features, encoded, ranking)
         low, high = tree_features.min(axis=0), tree_features.max(axis=0)
         edges = [
-            entry_edges(low[i], high[i], radius[i], self.max_entries) for i in range(self.n_levels_)
+            entry_edges(low[i], high[i], self.width_factor * radius[i], self.max_entries)
+            for i in range(self.n_levels_)
         ]
         self.index_ = IntervalIndex(edges, radius)
         self.index_.insert(tree_features)
@@ -379,7 +388,12 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             pairs = label_pairs(encoded, _MAX_PAIRS, rng)
         target = _DEFAULT_RECALL if self.target_recall is None else self.target_recall
         radius, self.training_survival_ = learn_radius(
-            tree_features, *pairs, target, rng, max_entries=self.max_entries
+            tree_features,
+            *pairs,
+            target,
+            rng,
+            max_entries=self.max_entries,
+            width_factor=self.width_factor,
         )
         return radius
 

@@ -54,9 +54,9 @@ def learn_delta(features, labels, quantile):
 # Per-level quantiles of the similar pairs' distances tried as the shape of the radii.
 _PROFILE_QUANTILES = (0.5, 0.75, 0.9, 0.97, 0.995)
 # Bisection steps on the radii's common scale.
-_STEPS = 24
+_STEPS = 16
 # Random pairs of training clips on which the pruning of each choice is estimated.
-_RANDOM_PAIRS = 20_000
+_RANDOM_PAIRS = 10_000
 
 
 def weighted_quantile(values, weights, q):
@@ -108,7 +108,7 @@ def label_pairs(labels, max_pairs, rng):
     return first, second, weight
 
 
-def surviving(query, stored, radius, low, high, max_entries):
+def surviving(query, stored, radius, low, high, max_entries, width_factor=1.0):
     """Whether each (query, stored) pair of vectors survives the tree, exactly.
 
     The stored vector sits in every entry its covering interval overlaps; the
@@ -117,7 +117,7 @@ def surviving(query, stored, radius, low, high, max_entries):
     """
     keep = np.ones(len(query), dtype=bool)
     for i in range(query.shape[1]):
-        edges = entry_edges(low[i], high[i], radius[i], max_entries)
+        edges = entry_edges(low[i], high[i], width_factor * radius[i], max_entries)
         entry = np.searchsorted(edges, query[:, i], side="right")
         first = np.searchsorted(edges, stored[:, i] - radius[i], side="left")
         last = np.searchsorted(edges, stored[:, i] + radius[i], side="right")
@@ -125,7 +125,9 @@ def surviving(query, stored, radius, low, high, max_entries):
     return keep
 
 
-def learn_radius(features, first, second, weight, target_recall, rng, *, max_entries=64):
+def learn_radius(
+    features, first, second, weight, target_recall, rng, *, max_entries=64, width_factor=1.0
+):
     """Per-level radii keeping ``target_recall`` of the similar pairs, pruning the most.
 
     For each candidate shape of the radii (a per-level quantile of the similar
@@ -150,7 +152,9 @@ def learn_radius(features, first, second, weight, target_recall, rng, *, max_ent
     a, b = rng.randint(0, len(features), size=(2, _RANDOM_PAIRS))
 
     def recall_at(radius):
-        keep = surviving(features[first], features[second], radius, low, high, max_entries)
+        keep = surviving(
+            features[first], features[second], radius, low, high, max_entries, width_factor
+        )
         return float(weight[keep].sum() / weight.sum())
 
     best = None
@@ -165,7 +169,9 @@ def learn_radius(features, first, second, weight, target_recall, rng, *, max_ent
             mid = 0.5 * (lo + hi)
             lo, hi = (lo, mid) if recall_at(mid * shape) >= target_recall else (mid, hi)
         radius = np.maximum(hi * shape, floor)
-        survive = float(surviving(features[a], features[b], radius, low, high, max_entries).mean())
+        survive = float(
+            surviving(features[a], features[b], radius, low, high, max_entries, width_factor).mean()
+        )
         if best is None or survive < best[1]:
             best = (radius, survive)
     return best

@@ -33,17 +33,18 @@ def test_weighted_quantile_against_repetition():
         assert weighted_quantile(values, counts.astype(float), q) == expected
 
 
-def test_surviving_is_what_the_tree_returns():
+@pytest.mark.parametrize("width_factor", [1.0, 2.0, 0.5])
+def test_surviving_is_what_the_tree_returns(width_factor):
     rng = np.random.default_rng(1)
     features = rng.uniform(-1, 1, size=(60, 3))
     radius = np.array([0.2, 0.35, 0.1])
     low, high = features.min(axis=0), features.max(axis=0)
-    edges = [entry_edges(low[i], high[i], radius[i], 64) for i in range(3)]
+    edges = [entry_edges(low[i], high[i], width_factor * radius[i], 64) for i in range(3)]
     index = IntervalIndex(edges, radius)
     index.insert(features)
     found = index.candidates(features)
     query, stored = np.divmod(np.arange(60 * 60), 60)
-    keep = surviving(features[query], features[stored], radius, low, high, 64)
+    keep = surviving(features[query], features[stored], radius, low, high, 64, width_factor)
     truth = np.zeros(60 * 60, bool)
     for q, c in enumerate(found):
         truth[q * 60 + c] = True
