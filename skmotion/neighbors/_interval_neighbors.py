@@ -353,19 +353,28 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self.classes_ = np.unique(y if classes is None else classes)
         self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
-        self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
-        radius = self.radius_ = self._radius(tree_features, encoded, ranking)
-        low, high = tree_features.min(axis=0), tree_features.max(axis=0)
-        edges = [
-            entry_edges(low[i], high[i], self.width_factor * radius[i], self.max_entries)
-            for i in range(self.n_levels_)
-        ]
-        self.index_ = IntervalIndex(edges, radius)
+        self.index_ = IntervalIndex(*self._layout(tree_features, encoded, ranking))
         self.index_.insert(tree_features)
         names = ("weights", "vectors") if self.effective_metric_ == "psi" else ("table",)
         self._stored = GrowableStore(("tree", "encoded", "labels") + names)
         self._store(tree_features, ranking, encoded)
         return self
+
+    def _layout(self, tree_features, encoded, ranking):
+        """Learn ``delta_`` and ``radius_``; return the tree's (edges, radius).
+
+        The layout depends on the training feature vectors and labels only (and
+        on psi signatures for ``similar="psi"``), so a sharded index learns it
+        once and every shard uses it.
+        """
+        self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
+        radius = self.radius_ = self._radius(tree_features, encoded, ranking)
+        low, high = tree_features.min(axis=0), tree_features.max(axis=0)
+        edges = [
+            entry_edges(low[i], high[i], self.width_factor * radius[i], self.max_entries)
+            for i in range(len(radius))
+        ]
+        return edges, radius
 
     def _radius(self, tree_features, encoded, ranking):
         """Each level's radius by the paper's rule or learned for the recall asked."""
