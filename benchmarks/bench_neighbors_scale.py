@@ -11,14 +11,17 @@ memory (tree, stored psi signatures, peak resident set).
 
 Clips: 2-4 s windows of long synthetic performances (``crop_pool``), the first
 30 channels (10 joints); similar = the same performance; 7 levels,
-``target_recall=0.99``, ``width_factor=2`` (about 2^7 rather than 3^7 leaves per
+``target_recall=0.99`` of the psi nearest neighbours (``similar="psi"``: the
+1-NN is what is timed), ``width_factor=2`` (about 2^7 rather than 3^7 leaves per
 clip: the memory of 10^6 clips stays in a few GB). 10^6 clips: generating and decomposing a million clips
 takes too long on a shared 2-core machine, so that row indexes feature vectors
 directly (table input, Euclidean ranking): the 10^5 clips' feature vectors and
-nine jittered copies of each (noise 0.2 x the learned radii, same label); its
+nine jittered copies of each (noise 0.2 x the learned radii; label = the source
+clip, so similar = its copies; agreement there is with brute-force kNN); its
 brute-force psi figure is the 10^5 one times 10 (brute force is linear in the
 collection; marked "extrapolated").
-Run: ``python benchmarks/bench_neighbors_scale.py`` (``--sizes 10000`` for a quick run).
+Run: ``python benchmarks/bench_neighbors_scale.py`` (``--sizes 10000`` for a quick run;
+``--sharded`` for the sharded index on two local Dask workers against one index).
 """
 
 import resource
@@ -30,7 +33,7 @@ import numpy as np
 from sklearn.neighbors import NearestNeighbors
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_results  # noqa: E402
+from _common import interleaved, write_results  # noqa: E402
 from _motion_data import crop_pool  # noqa: E402
 
 from skmotion.decomposition._clip_svd import small_blas  # noqa: E402
@@ -42,7 +45,13 @@ SIZES = (10_000, 100_000, 1_000_000)
 N_QUERIES = 300
 N_INSERTS = 50
 CHANNELS = 30
-PARAMS = {"n_levels": 7, "target_recall": 0.99, "width_factor": 2.0, "random_state": 0}
+PARAMS = {
+    "n_levels": 7,
+    "target_recall": 0.99,
+    "similar": "psi",
+    "width_factor": 2.0,
+    "random_state": 0,
+}
 
 
 def cpu_us(func, n):
@@ -123,13 +132,13 @@ def feature_row(n, base, psi_us_base, n_base):
             for c in range(copies)
         ]
     )[:n]
-    labels = np.tile(base.labels_, copies)[:n]
+    labels = np.tile(np.arange(len(base._tree_features)), copies)[:n]  # the source clip
     queries = (
         features[rng.choice(n, N_QUERIES, replace=False)]
         + rng.normal(size=(N_QUERIES, features.shape[1])) * noise
     )
     start, cpu = time.perf_counter(), time.process_time()
-    index = IntervalIndexNeighbors(**PARAMS).fit(features, labels)
+    index = IntervalIndexNeighbors(**{**PARAMS, "similar": "labels"}).fit(features, labels)
     fit_s, fit_cpu = time.perf_counter() - start, time.process_time() - cpu
     ours_us, ours = cpu_us(
         lambda: index.kneighbors(queries, return_distance=False)[:, 0], N_QUERIES
@@ -152,15 +161,73 @@ def feature_row(n, base, psi_us_base, n_base):
         "brute_knn_features_cpu_us": knn_us,
         "speedup_vs_brute_psi": psi_us / ours_us,
         "speedup_vs_brute_knn": knn_us / ours_us,
-        "agrees_with_brute_psi": float("nan"),
+        "agrees_with_brute_psi": float(np.mean(ours == knn)),  # here: with brute kNN
         "candidates_share": float(np.mean([len(c) for c in index.candidates(queries)])) / n,
         "insert_cpu_ms_median": float(np.median(insert_ms)),
         "leaf_entries_per_clip": index.index_.n_stored() / n,
         "tree_MB": index.index_.nbytes() / 1e6,
         "stored_signatures_MB": index._ranking.nbytes / 1e6,
         "peak_rss_MB": peak_rss_mb(),
-        "agrees_with_brute_knn": float(np.mean(ours == knn)),
     }
+
+
+def sharded_rows(n=10_000, n_queries=N_QUERIES):
+    """The sharded index on two local Dask workers (processes, loopback) against one index.
+
+    Wall-clock seconds per query batch, timed in alternation (the two share the
+    machine's load); the answers compared id by id.
+    """
+    try:
+        import dask
+        import distributed
+    except ImportError:
+        print('dask is not installed (pip install "skmotion[distributed]"): no sharded row')
+        return []
+    from skmotion.neighbors import ShardedIntervalIndex
+
+    pool, labels = crop_pool(n + n_queries, random_state=3)
+    pool = [c[:, :CHANNELS] for c in pool]
+    stored, queries = pool[:n], pool[n:]
+    params = {**PARAMS, "similar": "labels"}  # the sharded index learns from labels
+    single = IntervalIndexNeighbors(**params).fit(stored, labels[:n])
+    rows = []
+    with dask.config.set({"distributed.comm.timeouts.connect": "60s"}):
+        cluster = distributed.LocalCluster(
+            n_workers=2,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            dashboard_address=None,
+        )
+        try:
+            with distributed.Client(cluster) as client:
+                client.wait_for_workers(2, timeout=120)
+                start = time.perf_counter()
+                sharded = ShardedIntervalIndex(
+                    IntervalIndexNeighbors(**params), client=client, n_shards=2
+                ).fit(stored, labels[:n])
+                sharded_fit = time.perf_counter() - start
+                one, two = interleaved(
+                    [lambda: single.kneighbors(queries), lambda: sharded.kneighbors(queries)], 5
+                )
+                same_ids = np.array_equal(
+                    single.kneighbors(queries, 5)[1], sharded.kneighbors(queries, 5)[1]
+                )
+                rows.append(
+                    {
+                        "stored": n,
+                        "queries": n_queries,
+                        "single_index_ms_per_batch": 1e3 * one,
+                        "sharded_2_workers_ms_per_batch": 1e3 * two,
+                        "sharded_over_single": two / one,
+                        "sharded_fit_s": sharded_fit,
+                        "identical_5nn_ids": bool(same_ids),
+                    }
+                )
+                print(rows[-1], flush=True)
+        finally:
+            cluster.close(timeout=60)
+    return rows
 
 
 def main(sizes=SIZES):
@@ -189,7 +256,15 @@ def main(sizes=SIZES):
 
 
 if __name__ == "__main__":
-    if "--sizes" in sys.argv:
+    if "--sharded" in sys.argv:
+        write_results(
+            "neighbors_sharded",
+            sharded_rows(),
+            notes="ShardedIntervalIndex on a LocalCluster (2 worker processes, 1 thread each, "
+            f"loopback TCP) against IntervalIndexNeighbors in this process; {PARAMS}; wall-clock "
+            "medians of 5 alternated rounds, on a shared 2-core machine.",
+        )
+    elif "--sizes" in sys.argv:
         main(tuple(int(v) for v in sys.argv[sys.argv.index("--sizes") + 1].split(",")))
     else:
         main()

@@ -59,21 +59,23 @@ class _Shard:
         )
         return 1.0 - similarity
 
-    def counts(self, tree):
-        """Number of candidates of each query in this shard."""
-        return np.array([len(self.index.leaf_items(leaf)) for leaf in self.index.leaf_of(tree)])
-
     def candidates(self, tree):
         return [c + self.offset for c in self.index.candidates(tree)]
 
-    def nearest(self, tree, query, n_neighbors, everything):
-        """(distances, global ids) of each query's nearest candidates in this shard.
+    def nearest(self, payload, n_neighbors, everything=None):
+        """Candidate counts, and (distances, global ids) of each query's nearest candidates.
 
-        Queries flagged in ``everything`` are ranked against all this shard's
-        clips (the single index's rule when the leaf holds too few clips). Rows
-        with fewer clips than ``n_neighbors`` are padded with infinite distances.
+        ``payload`` is the queries' (tree features, signatures). Queries flagged
+        in ``everything`` are ranked against all this shard's clips instead (the
+        single index's rule when a leaf holds too few clips). Rows with fewer
+        clips than ``n_neighbors`` are padded with infinite distances.
         """
+        tree, query = payload
         n = len(self.weights)
+        leaves = self.index.leaf_of(tree)
+        counts = np.array([len(self.index.leaf_items(leaf)) for leaf in leaves])
+        if everything is None:
+            everything = np.zeros(len(tree), dtype=bool)
 
         def rank_leaf(leaf, rows):
             out_d = np.full((len(rows), n_neighbors), np.inf)
@@ -93,7 +95,17 @@ class _Shard:
             return out_d, out_i
 
         # nearest_in_leaves ranks rows grouped by leaf, rows sorted within a leaf.
-        return nearest_in_leaves(self.index.leaf_of(tree), rank_leaf, n_neighbors)
+        return (counts, *nearest_in_leaves(leaves, rank_leaf, n_neighbors))
+
+
+def _wait(futures):
+    try:
+        from distributed import wait
+    except ImportError as exc:  # the client came from somewhere: say what is missing
+        raise ImportError(
+            'ShardedIntervalIndex needs Dask: pip install "skmotion[distributed]".'
+        ) from exc
+    wait(futures)
 
 
 def _call(shard, method, *args):
@@ -172,9 +184,7 @@ class ShardedIntervalIndex:
             self.client.submit(_Shard, s, tree[a:b], edges, radius, layout.k, a)
             for s, a, b in zip(spectra, bounds[:-1], bounds[1:])
         ]
-        self.client.gather(
-            [self.client.submit(_call, s, "counts", tree[:1]) for s in self.shards_]
-        )  # wait until built: fit's time is the fit
+        _wait(self.shards_)  # until built (the shards stay on the workers)
         self.layout_, self.labels_, self.n_samples_fit_ = layout, np.asarray(y), len(clips)
         return self
 
@@ -185,9 +195,9 @@ class ShardedIntervalIndex:
         n_vectors = max(min(layout.k, clips.n_channels), N_VECTORS[weighting])
         method = "iterative" if weighting == "first" else "exact"
         spectra = clip_spectra(clips, n_vectors, method=method)
-        tree = svd_project(layout.projection_, *spectra)
-        signatures = signatures_from_spectra(*spectra, layout.k)
-        return self.client.scatter([(tree, signatures)], broadcast=True)[0]
+        return svd_project(layout.projection_, *spectra), signatures_from_spectra(
+            *spectra, layout.k
+        )
 
     def _each(self, method, *args):
         futures = [self.client.submit(_call, s, method, *args, pure=False) for s in self.shards_]
@@ -195,8 +205,7 @@ class ShardedIntervalIndex:
 
     def candidates(self, X):
         """Each query's candidate ids (sorted), as :meth:`IntervalIndexNeighbors.candidates`."""
-        data = self._query(X)
-        tree = self.client.submit(lambda d: d[0], data)
+        tree = self._query(X)[0]
         parts = self._each("candidates", tree)
         return [np.sort(np.concatenate(c)) for c in zip(*parts)]
 
@@ -208,13 +217,21 @@ class ShardedIntervalIndex:
                 f"n_neighbors must be an integer from 1 to {self.n_samples_fit_}; "
                 f"got {n_neighbors!r}."
             )
-        data = self._query(X)
-        tree = self.client.submit(lambda d: d[0], data)
-        query = self.client.submit(lambda d: d[1], data)
-        everything = sum(self._each("counts", tree)) < n_neighbors
-        parts = self._each("nearest", tree, query, n_neighbors, everything)
-        distances = np.concatenate([p[0] for p in parts], axis=1)
-        ids = np.concatenate([p[1] for p in parts], axis=1)
+        payload = self.client.scatter([self._query(X)], broadcast=True)[0]
+        parts = self._each("nearest", payload, n_neighbors)
+        everything = sum(p[0] for p in parts) < n_neighbors
+        if everything.any():  # a second round only for queries whose leaves hold too few
+            again = self._each("nearest", payload, n_neighbors, everything)
+            parts = [
+                (
+                    c,
+                    np.where(everything[:, None], a[1], p[1]),
+                    np.where(everything[:, None], a[2], p[2]),
+                )
+                for c, p, a in zip((p[0] for p in parts), parts, again)
+            ]
+        distances = np.concatenate([p[1] for p in parts], axis=1)
+        ids = np.concatenate([p[2] for p in parts], axis=1)
         # By distance, then by id: the single index's order.
         order = np.lexsort((ids, distances), axis=1)[:, :n_neighbors]
         ids = np.take_along_axis(ids, order, axis=1)
