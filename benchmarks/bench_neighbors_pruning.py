@@ -1,11 +1,13 @@
 """Pruning efficiency and recall of the interval index (Li & Prabhakaran, Figures 7-14).
 
 Default run (``python benchmarks/bench_neighbors_pruning.py``: the default
-levels, 7 capped by the data; ``--levels 5,7,9`` for others): on every development set, held-out queries against an index fitted
-on the rest, for the learned widths (``target_recall`` 0.99 and 0.95) and the
-paper's rule (epsilon 1.0 and 0.8). ``--grid``: the leave-one-out sweep below.
+levels, 7 capped by the data; ``--levels 5,7,9`` for others): on every
+development set, held-out queries against an index fitted on the rest, for the
+learned widths (``target_recall`` 0.99 and 0.95) and the paper's rule (epsilon
+1.0 and 0.8). ``--grid``: the leave-one-out sweep below.
 
-Grid (``--grid``): every clip of a collection queries the index built on the collection and is left
+Grid (``--grid``): every clip of a collection queries the index built on the
+collection and is left
 out of its own counts (the paper's protocol). Similar = same label. Swept:
 ``epsilon`` 0.5-1.2 and ``n_levels`` 5-12, for the first and the weighted first
 two singular vectors.
@@ -153,11 +155,14 @@ def main(levels=(None,)):
     write_results(
         "neighbors_pruning",
         rows,
-        notes="Held-out queries: the last repetition of each motion/trial (synthetic, CMU) or the UEA "
+        notes="Held-out queries: the last repetition of each motion/trial (synthetic, CMU) or "
+        "the UEA "
         "test split query an index fitted on the rest (the training split). Similar = same label. "
-        "pruning = irrelevant stored clips pruned / irrelevant stored clips; recall = similar stored "
+        "pruning = irrelevant stored clips pruned / irrelevant stored clips; recall = similar "
+        "stored "
         "clips returned / similar stored clips (means over the queries); train_* = the training "
-        "clips querying their own index, leaving themselves out. target_recall rows learn the radii "
+        "clips querying their own index, leaving themselves out. target_recall rows learn the "
+        "radii "
         "on the training clips only.",
     )
     return rows
@@ -209,8 +214,10 @@ def grid():
     write_results(
         "neighbors_pruning_grid",
         rows,
-        notes="Leave-one-out queries; pruning = irrelevant clips pruned / irrelevant clips; recall = similar clips "
-        f"returned / similar clips (similar = same label). Trees over {MAX_PAIRS:,} leaf entries are not built (nan).",
+        notes="Leave-one-out queries; pruning = irrelevant clips pruned / irrelevant clips; "
+        "recall = similar clips "
+        f"returned / similar clips (similar = same label). Trees over {MAX_PAIRS:,} leaf "
+        "entries are not built (nan).",
     )
     summary = []
     for name, weighting in sorted({(r["dataset"], r["features"]) for r in rows}):
@@ -248,14 +255,18 @@ def grid():
     write_results(
         "neighbors_pruning_delta",
         deltas,
-        notes="Weighted first two singular vectors, 7 components. delta_over_range: delta_i (the within-label range "
-        "of component i: the maximum over the labels = the paper's rule, or a quantile) over the component's range, "
-        "averaged over the components; widest_labels: the labels with the largest mean relative range.",
+        notes="Weighted first two singular vectors, 7 components. delta_over_range: delta_i "
+        "(the within-label range "
+        "of component i: the maximum over the labels = the paper's rule, or a quantile) over "
+        "the component's range, "
+        "averaged over the components; widest_labels: the labels with the largest mean "
+        "relative range.",
     )
     write_results(
         "neighbors_pruning_summary",
         summary,
-        notes="Best pruning over the grid at a recall bound; the paper reports ~90% (body) to 95% (hand) at ~100% recall with eps 0.8-1.0, 7 levels.",
+        notes="Best pruning over the grid at a recall bound; the paper reports ~90% (body) to "
+        "95% (hand) at ~100% recall with eps 0.8-1.0, 7 levels.",
     )
     try:
         from skmotion.plotting import plot_pruning_recall
@@ -271,7 +282,10 @@ def grid():
 
 
 def quantile_sweep():
-    """The robust delta (a quantile over the labels) at 7 levels, where the paper's maximum prunes little."""
+    """The robust delta (a quantile over the labels) at 7 levels.
+
+    Where the paper's maximum prunes little.
+    """
     rows = []
     for name, (clips, labels) in search_datasets().items():
         ids = np.arange(len(clips))
@@ -295,7 +309,8 @@ def quantile_sweep():
     write_results(
         "neighbors_pruning_quantile",
         rows,
-        notes="7 levels, weighted first two singular vectors; delta_i = this quantile over the labels of the "
+        notes="7 levels, weighted first two singular vectors; delta_i = this quantile over the "
+        "labels of the "
         "within-label range (1.0 = the paper's maximum). Leave-one-out queries.",
     )
 

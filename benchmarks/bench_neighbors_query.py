@@ -73,8 +73,8 @@ def traversal_rows(index, features, n):
     stored = index._tree_features
     for algorithm in ("brute", "kd_tree"):
         nn = NearestNeighbors(n_neighbors=1, algorithm=algorithm).fit(stored)
-        seconds, _ = time_call(lambda: nn.kneighbors(tree), repeats=3)
-        one, _ = time_call(lambda: [nn.kneighbors(q[None]) for q in singles[:50]], repeats=1)
+        seconds, _ = time_call(lambda nn=nn: nn.kneighbors(tree), repeats=3)
+        one, _ = time_call(lambda nn=nn: [nn.kneighbors(q[None]) for q in singles[:50]], repeats=1)
         rows.append(
             {
                 "collection": n,
@@ -149,7 +149,7 @@ def end_to_end_rows(index, db_clips, db_labels, queries, query_labels, n):
     return rows
 
 
-def dtw_rows(clips, labels, queries, query_labels, n=300, n_queries=30, extrapolate_to=max(SIZES)):
+def dtw_rows(clips, labels, queries, query_labels, n=300, n_queries=30, extrapolate_to=None):
     """tslearn 1-NN DTW against the index on the same clips (a subset: DTW is slow).
 
     tslearn's ``KNeighborsTimeSeries(metric="dtw")`` computes the DTW distance
@@ -163,6 +163,7 @@ def dtw_rows(clips, labels, queries, query_labels, n=300, n_queries=30, extrapol
     except ImportError:
         print('tslearn is not installed (pip install "skmotion[bench]"): no DTW comparison')
         return []
+    extrapolate_to = max(SIZES) if extrapolate_to is None else extrapolate_to
     db, db_labels, q, q_labels = (
         clips[:n],
         labels[:n],
@@ -315,12 +316,14 @@ def main():
     write_results(
         "neighbors_traversal",
         rows,
-        notes="Microseconds per query to reach the leaf (7 levels, target_recall 0.99) vs sklearn 1-NN on the same 7-D feature vectors.",
+        notes="Microseconds per query to reach the leaf (7 levels, target_recall 0.99) vs "
+        "sklearn 1-NN on the same 7-D feature vectors.",
     )
     write_results(
         "neighbors_end_to_end",
         end_rows,
-        notes=f"{N_QUERIES} held-out clips query collections of 2-4 s synthetic clips (75 channels); same_motion = the 1-NN is a clip of the query's motion.",
+        notes=f"{N_QUERIES} held-out clips query collections of 2-4 s synthetic clips (75 "
+        "channels); same_motion = the 1-NN is a clip of the query's motion.",
     )
 
 

@@ -9,17 +9,16 @@ query (the machine is shared: CPU time varies less than wall time), the
 answers' agreement with brute-force psi, the time to insert one clip, and
 memory (tree, stored psi signatures, peak resident set).
 
-Clips: 2-4 s windows of long synthetic performances (``crop_pool``), the first
-30 channels (10 joints); similar = the same performance; 7 levels,
-``target_recall=0.99`` of the psi nearest neighbours (``similar="psi"``: the
-1-NN is what is timed), ``width_factor=2`` (about 2^7 rather than 3^7 leaves per
-clip: the memory of 10^6 clips stays in a few GB). 10^6 clips: generating and decomposing a million clips
-takes too long on a shared 2-core machine, so that row indexes feature vectors
-directly (table input, Euclidean ranking): the 10^5 clips' feature vectors and
-nine jittered copies of each (noise 0.2 x the learned radii; label = the source
-clip, so similar = its copies; agreement there is with brute-force kNN); its
-brute-force psi figure is the 10^5 one times 10 (brute force is linear in the
-collection; marked "extrapolated").
+Clips: 2-4 s windows of long synthetic performances (``crop_pool``), the first 30
+channels (10 joints); similar = the same performance; 7 levels, ``target_recall=0.99``
+of the psi nearest neighbours (``similar="psi"``: the 1-NN is what is timed),
+``width_factor=2`` (about 2^7 rather than 3^7 leaves per clip: the memory of 10^6 clips
+stays in a few GB). 10^6 clips: generating and decomposing a million clips takes too
+long on a shared 2-core machine, so that row indexes feature vectors directly (table
+input, Euclidean ranking): the 10^5 clips' feature vectors and nine jittered copies of
+each (noise 0.2 x the learned radii; label = the source clip, so similar = its copies;
+agreement there is with brute-force kNN); its brute-force psi figure is the 10^5 one
+times 10 (brute force is linear in the collection; marked "extrapolated").
 Run: ``python benchmarks/bench_neighbors_scale.py`` (``--sizes 10000`` for a quick run;
 ``--sharded`` for the sharded index on two local Dask workers against one index).
 """
