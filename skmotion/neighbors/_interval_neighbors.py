@@ -11,18 +11,16 @@ from sklearn.utils.validation import check_is_fitted, column_or_1d, validate_dat
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.decomposition import SVDFeatureExtractor
-from skmotion.decomposition._clip_svd import clip_spectra
 from skmotion.decomposition._svd_projection import (
-    N_VECTORS,
     fit_svd_projection,
-    max_svd_components,
     svd_project,
 )
+from skmotion.neighbors._describe import clip_level_limit, index_spectra, resolve_levels
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
 from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_k
 from skmotion.neighbors._store import GrowableStore
-from skmotion.neighbors._widths import label_pairs, learn_delta, learn_radius, psi_pairs
+from skmotion.neighbors._widths import learn_delta, radius_for_recall
 from skmotion.utils._clips import check_clips
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
@@ -34,9 +32,6 @@ _LEAVES_PER_TASK = 32
 _DEFAULT_LEVELS = 7
 # The recall the entry widths are learned for when neither rule is given.
 _DEFAULT_RECALL = 0.99
-# Similar pairs target_recall learns from (drawn beyond this), and psi anchors.
-_MAX_PAIRS = 50_000
-_PSI_ANCHORS = 2_000
 
 
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -264,18 +259,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             return table[:, : self.n_levels_], table
         clips = check_clips(X, estimator=self, reset=reset)
         weighting = self._weighting()
-        n_vectors = max(min(self.k, clips.n_channels), N_VECTORS[weighting])
-        # Only the leading pairs are needed unless "first_two" weighs by all singular values.
-        method = "iterative" if weighting == "first" else "exact"
-        spectra = clip_spectra(clips, n_vectors, method=method, n_jobs=self.n_jobs)
+        spectra = index_spectra(clips, weighting, self.k, n_jobs=self.n_jobs)
         if reset:
-            limit = max_svd_components(len(clips), clips.n_channels, weighting)
-            self.n_levels_ = self._resolve_levels(
-                limit,
-                f"SVD feature components the clips allow (at most the {len(clips)} training "
-                f"clips and the composite vector's {N_VECTORS[weighting]} x "
-                f"{clips.n_channels} channels)",
-            )
+            self.n_levels_ = self._resolve_levels(*clip_level_limit(clips, weighting))
             self.projection_ = fit_svd_projection(*spectra, self.n_levels_, weighting)
         return svd_project(self.projection_, *spectra), signatures_from_spectra(*spectra, self.k)
 
@@ -285,21 +271,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     def _resolve_levels(self, limit, what):
         """``n_levels_``: the levels asked for, or the capped default (see ``n_levels``)."""
         from_features = None if self.features is None else self.features.n_components
-        if self.n_levels is not None and from_features not in (None, self.n_levels):
-            raise ValueError(
-                f"n_levels={self.n_levels} and features.n_components={from_features} disagree: "
-                "the tree has one level per feature component. Set one of them (or both equal)."
-            )
-        asked = self.n_levels if self.n_levels is not None else from_features
-        if asked is None:
-            return min(_DEFAULT_LEVELS, limit)
-        if asked > limit:
-            raise ValueError(
-                f"n_levels={asked} is more than the {limit} {what}: the tree has one level "
-                f"per feature component. "
-                f"Pass n_levels={limit} or fewer, or n_levels=None for min(7, {limit})."
-            )
-        return int(asked)
+        return resolve_levels(self.n_levels, from_features, limit, what, _DEFAULT_LEVELS)
 
     @property
     def feature_extractor_(self):
@@ -387,22 +359,17 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         if self.epsilon is not None:
             self.width_rule_ = "epsilon"
             return self.epsilon * self.delta_
+        if self.similar == "psi" and self.effective_metric_ != "psi":
+            raise ValueError('similar="psi" needs clips; X is a table of feature vectors.')
         self.width_rule_ = "target_recall"
-        rng = check_random_state(self.random_state)
-        if self.similar == "psi":
-            if self.effective_metric_ != "psi":
-                raise ValueError('similar="psi" needs clips; X is a table of feature vectors.')
-            pairs = psi_pairs(ranking, _PSI_ANCHORS, rng, n_jobs=self.n_jobs)
-        else:
-            pairs = label_pairs(encoded, _MAX_PAIRS, rng)
-        target = _DEFAULT_RECALL if self.target_recall is None else self.target_recall
-        radius, self.training_survival_ = learn_radius(
+        radius, self.training_survival_ = radius_for_recall(
             tree_features,
-            *pairs,
-            target,
-            rng,
+            encoded if self.similar == "labels" else ranking,
+            _DEFAULT_RECALL if self.target_recall is None else self.target_recall,
+            check_random_state(self.random_state),
             max_entries=self.max_entries,
             width_factor=self.width_factor,
+            n_jobs=self.n_jobs,
         )
         return radius
 

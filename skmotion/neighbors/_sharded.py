@@ -16,13 +16,8 @@ the merged neighbours are the single index's neighbours.
 import numpy as np
 from sklearn.base import clone
 
-from skmotion.decomposition._clip_svd import clip_spectra
-from skmotion.decomposition._svd_projection import (
-    N_VECTORS,
-    fit_svd_projection,
-    max_svd_components,
-    svd_project,
-)
+from skmotion.decomposition._svd_projection import N_VECTORS, fit_svd_projection, svd_project
+from skmotion.neighbors._describe import clip_level_limit, index_spectra
 from skmotion.neighbors._interval_index import IntervalIndex
 from skmotion.neighbors._interval_neighbors import IntervalIndexNeighbors
 from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
@@ -32,9 +27,9 @@ from skmotion.utils._clips import check_clips
 __all__ = ["ShardedIntervalIndex"]
 
 
-def _spectra(clips, n_vectors, method):
+def _spectra(clips, weighting, k):
     """On a worker: a shard's spectra (kept there) ..."""
-    return clip_spectra(check_clips(clips), n_vectors, method=method)
+    return index_spectra(check_clips(clips), weighting, k)
 
 
 def _summary(spectra, n_vectors):
@@ -162,19 +157,16 @@ class ShardedIntervalIndex:
         clips = check_clips(X, estimator=layout, reset=True)
         y = layout._check_labels(y, len(clips))
         weighting = layout._weighting()
-        n_vectors = max(min(layout.k, clips.n_channels), N_VECTORS[weighting])
-        method = "iterative" if weighting == "first" else "exact"
         n_shards = self.n_shards or len(self.client.scheduler_info()["workers"])
         bounds = np.linspace(0, len(clips), n_shards + 1).astype(int)
         parts = [list(clips[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
-        spectra = [self.client.submit(_spectra, p, n_vectors, method) for p in parts]
+        spectra = [self.client.submit(_spectra, p, weighting, layout.k) for p in parts]
         summaries = self.client.gather(
             [self.client.submit(_summary, s, N_VECTORS[weighting]) for s in spectra]
         )
         eigenvalues = np.concatenate([s[0] for s in summaries])
         vectors = np.concatenate([s[1] for s in summaries])
-        limit = max_svd_components(len(clips), clips.n_channels, weighting)
-        layout.n_levels_ = layout._resolve_levels(limit, "SVD feature components the clips allow")
+        layout.n_levels_ = layout._resolve_levels(*clip_level_limit(clips, weighting))
         layout.projection_ = fit_svd_projection(eigenvalues, vectors, layout.n_levels_, weighting)
         tree = svd_project(layout.projection_, eigenvalues, vectors)
         layout.input_kind_, layout.effective_metric_ = "clips", "psi"
@@ -191,10 +183,7 @@ class ShardedIntervalIndex:
     def _query(self, X):
         layout = self.layout_
         clips = check_clips(X, estimator=layout)
-        weighting = layout._weighting()
-        n_vectors = max(min(layout.k, clips.n_channels), N_VECTORS[weighting])
-        method = "iterative" if weighting == "first" else "exact"
-        spectra = clip_spectra(clips, n_vectors, method=method)
+        spectra = index_spectra(clips, layout._weighting(), layout.k)
         return svd_project(layout.projection_, *spectra), signatures_from_spectra(
             *spectra, layout.k
         )

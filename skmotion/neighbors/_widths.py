@@ -17,6 +17,7 @@ __all__ = [
     "learn_delta",
     "learn_radius",
     "psi_pairs",
+    "radius_for_recall",
     "surviving",
     "weighted_quantile",
 ]
@@ -51,6 +52,9 @@ def learn_delta(features, labels, quantile):
     return np.quantile(spreads, quantile, axis=0)
 
 
+# Similar pairs target_recall learns from (drawn beyond this), and psi anchors.
+_MAX_PAIRS = 50_000
+_PSI_ANCHORS = 2_000
 # Per-level quantiles of the similar pairs' distances tried as the shape of the radii.
 _PROFILE_QUANTILES = (0.5, 0.75, 0.9, 0.97, 0.995)
 # Bisection steps on the radii's common scale.
@@ -196,3 +200,26 @@ def psi_pairs(signatures, n_anchors, rng, *, n_jobs=None):
 
     second = np.concatenate(parallel_map(nearest, rows, n_jobs=n_jobs))
     return first, second, np.ones(len(first))
+
+
+def radius_for_recall(
+    tree_features, similar, target_recall, rng, *, max_entries=64, width_factor=1.0, n_jobs=None
+):
+    """:func:`learn_radius` on the similar pairs of labels or of psi signatures.
+
+    ``similar`` is the clips' encoded labels (an int array: same label =
+    similar) or their psi signatures ``(weights, vectors)`` (each clip and its
+    psi nearest neighbour are similar). Returns ``(radius, survival)``.
+    """
+    if isinstance(similar, tuple):
+        pairs = psi_pairs(similar, _PSI_ANCHORS, rng, n_jobs=n_jobs)
+    else:
+        pairs = label_pairs(similar, _MAX_PAIRS, rng)
+    return learn_radius(
+        tree_features,
+        *pairs,
+        target_recall,
+        rng,
+        max_entries=max_entries,
+        width_factor=width_factor,
+    )

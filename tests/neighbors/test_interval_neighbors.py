@@ -141,7 +141,8 @@ def test_kneighbors_with_all_candidates_is_the_brute_force_psi_ranking(repeated)
     reference = 1 - pairwise_psi(queries, clips)
     order = np.argsort(reference, axis=1, kind="stable")[:, :5]
     np.testing.assert_array_equal(neighbours, order)
-    np.testing.assert_allclose(distances, np.take_along_axis(reference, order, axis=1), atol=1e-12)
+    # The index finds the leading eigenpairs iteratively (residual <= 1e-9 of the largest).
+    np.testing.assert_allclose(distances, np.take_along_axis(reference, order, axis=1), atol=1e-8)
     # X=None: every stored clip against the others.
     distances, neighbours = index.kneighbors(n_neighbors=3)
     loo = 1 - pairwise_psi(clips)
