@@ -260,6 +260,10 @@ def query_cost_rows(n_stored=10_000, n_queries=1_000):
     cases = (
         ("query features, exact eigh", lambda: features("exact")),
         ("query features, iterative (the index's)", lambda: features("iterative")),
+        (
+            "query tree features only (first vector: what candidates needs)",
+            lambda: svd_project(projection, *clip_spectra(checked, 1, method="iterative")),
+        ),
         ("traversal, batched", lambda: index.index_.leaf_of(tree)),
         ("candidates: validation + features + traversal", lambda: index.candidates(queries)),
         ("end to end 1-NN: IntervalIndexNeighbors.kneighbors", lambda: index.kneighbors(queries)),

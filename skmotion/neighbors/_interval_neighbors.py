@@ -242,8 +242,12 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     # -- input -------------------------------------------------------------------
 
-    def _describe(self, X, *, reset):
-        """Validate ``X`` once; return (feature vectors, ranking data)."""
+    def _describe(self, X, *, reset, ranking=True):
+        """Validate ``X`` once; return (feature vectors, ranking data or None).
+
+        Without ranking (candidate sets only) a clip needs only its first
+        singular vector(s), not the ``k`` eigenvectors of psi.
+        """
         kind = input_kind(X)
         if reset:
             self.input_kind_ = kind
@@ -259,11 +263,12 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             return table[:, : self.n_levels_], table
         clips = check_clips(X, estimator=self, reset=reset)
         weighting = self._weighting()
-        spectra = index_spectra(clips, weighting, self.k, n_jobs=self.n_jobs)
+        spectra = index_spectra(clips, weighting, self.k if ranking else 0, n_jobs=self.n_jobs)
         if reset:
             self.n_levels_ = self._resolve_levels(*clip_level_limit(clips, weighting))
             self.projection_ = fit_svd_projection(*spectra, self.n_levels_, weighting)
-        return svd_project(self.projection_, *spectra), signatures_from_spectra(*spectra, self.k)
+        tree = svd_project(self.projection_, *spectra)
+        return tree, signatures_from_spectra(*spectra, self.k) if ranking else None
 
     def _weighting(self):
         return "first" if self.features is None else self.features.weighting
@@ -461,12 +466,12 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     # -- queries -------------------------------------------------------------------
 
-    def _queries(self, X):
+    def _queries(self, X, ranking=True):
         """(tree features, ranking data, self ids or None) of the queries."""
         check_is_fitted(self)
         if X is None:
             return self._tree_features, self._ranking, np.arange(self.n_samples_fit_)
-        tree_features, ranking = self._describe(X, reset=False)
+        tree_features, ranking = self._describe(X, reset=False, ranking=ranking)
         return tree_features, ranking, None
 
     def candidates(self, X=None):
@@ -483,7 +488,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             Sorted ids of stored clips (positions in the fitted collection, then
             inserted clips), one array per query.
         """
-        features, _, self_ids = self._queries(X)
+        features, _, self_ids = self._queries(X, ranking=False)
         found = self.index_.candidates(features)
         if self_ids is not None:
             found = [c[c != i] for c, i in zip(found, self_ids)]
