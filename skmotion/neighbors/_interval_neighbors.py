@@ -22,6 +22,7 @@ from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_
 from skmotion.neighbors._store import GrowableStore
 from skmotion.neighbors._widths import learn_delta, radius_for_recall
 from skmotion.utils._clips import check_clips
+from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["IntervalIndexNeighbors", "learn_delta"]
@@ -99,6 +100,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         both ``n_levels`` and a different ``features.n_components`` is an error.
     n_jobs : int, default=None
         Number of jobs for the SVDs and the ranking; results do not depend on it.
+    verbose : int, default=0
+        Print a line per stage of fit (decomposition, widths, tree) on
+        standard error when 1 or more; fit takes minutes at 10^5 clips.
     random_state : int, RandomState instance or None, default=None
         Draws the pairs ``target_recall`` learns from when there are more than
         50,000 (and the anchors of ``similar="psi"``, at most 2,000).
@@ -202,6 +206,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         "k": [Interval(Integral, 1, None, closed="left")],
         "features": [SVDFeatureExtractor, None],
         "n_jobs": [Integral, None],
+        "verbose": ["verbose"],
         "random_state": ["random_state"],
     }
     _motion_tags = MotionTags(output_kind="labels")
@@ -220,6 +225,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         k=6,
         features=None,
         n_jobs=None,
+        verbose=0,
         random_state=None,
     ):
         self.n_levels = n_levels
@@ -233,6 +239,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self.k = k
         self.features = features
         self.n_jobs = n_jobs
+        self.verbose = verbose
         self.random_state = random_state
 
     def __sklearn_tags__(self):
@@ -322,6 +329,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         return self._fit(X, y)
 
     def _fit(self, X, y, classes=None):
+        say(self.verbose, f"{type(self).__name__}: decomposing the clips")
         tree_features, ranking = self._describe(X, reset=True)
         y = self._check_labels(y, len(tree_features))
         if self.input_kind_ == "table":
@@ -330,7 +338,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         self.classes_ = np.unique(y if classes is None else classes)
         self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
+        say(self.verbose, f"{type(self).__name__}: learning the entry widths")
         self.index_ = IntervalIndex(*self._layout(tree_features, encoded, ranking))
+        say(self.verbose, f"{type(self).__name__}: building the tree ({self.n_levels_} levels)")
         self.index_.insert(tree_features)
         names = ("weights", "vectors") if self.effective_metric_ == "psi" else ("table",)
         self._stored = GrowableStore(("tree", "encoded", "labels") + names)

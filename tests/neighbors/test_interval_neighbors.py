@@ -328,3 +328,13 @@ def test_extreme_but_finite_clips_give_the_same_answers(repeated, scale):
     expected_distances, expected = index.kneighbors(clips[:5])
     np.testing.assert_array_equal(found, expected)
     np.testing.assert_allclose(distances, expected_distances, atol=1e-10)
+
+
+def test_verbose_reports_the_stages_of_fit_and_is_silent_by_default(repeated, capsys):
+    clips, target = repeated
+    IntervalIndexNeighbors(n_levels=3).fit(clips, target)
+    assert capsys.readouterr().err == ""
+    IntervalIndexNeighbors(n_levels=3, verbose=1).fit(clips, target)
+    err = capsys.readouterr().err
+    for stage in ("decomposing the clips", "learning the entry widths", "building the tree"):
+        assert stage in err
