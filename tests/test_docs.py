@@ -34,7 +34,7 @@ def test_python_examples_run(page, tmp_path, monkeypatch):
     if SHARED_DATA.is_dir():
         (tmp_path / "shared").symlink_to(SHARED_DATA.parent)
     monkeypatch.chdir(work)
-    namespace = {}
+    namespace = {"__name__": "__main__"}  # as when the page's code runs as a script
     for block in blocks:
         for module in NEEDS_MODULE.findall(block):
             pytest.importorskip(module, reason=f"{page.name} needs the optional {module}")

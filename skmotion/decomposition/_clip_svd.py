@@ -36,6 +36,11 @@ _CONTROLLER = None
 
 # Clips per task: fixed, so the tasks (and so the results) do not depend on n_jobs.
 _CHUNK = 512
+# Subspace iteration: residual tolerance (relative to the largest eigenvalue),
+# steps between convergence checks, and the steps before a full eigh takes over.
+_TOLERANCE = 1e-9
+_CHECK = 4
+_MAX_STEPS = 24
 
 
 def _rank_tolerance(eigenvalues):
@@ -44,26 +49,127 @@ def _rank_tolerance(eigenvalues):
     return eigenvalues.max(axis=-1, keepdims=True) * n * 10 * np.finfo(np.float64).eps
 
 
-def _spectra_of_chunk(chunk, n_vectors):
+def _unit_scale(clip):
+    """The clip divided by its largest absolute value (an all-zero clip unchanged).
+
+    Singular vectors and the shares of the singular values do not change with
+    the clip's scale, but its Gram matrix overflows for values near 1e154 and
+    underflows near 1e-154: scaled to a maximum of 1 it does neither.
+    """
+    clip = np.asarray(clip, dtype=np.float64)
+    peak = np.abs(clip).max() if clip.size else 0.0
+    return clip / peak if peak > 0 else clip
+
+
+def _leading_eigh(grams, n_vectors):
+    """Leading eigenpairs of stacked symmetric matrices by subspace iteration.
+
+    A block of ``n_vectors + 4`` vectors is multiplied by the matrices and
+    re-orthonormalised (one batched QR) a few times, then a Rayleigh-Ritz step
+    (a batched eigh of ``block x block`` matrices) gives the pairs. Every
+    ``_CHECK`` steps the residuals ``|G v - lambda v|`` are checked against
+    ``_TOLERANCE * lambda_1``; matrices not converged after ``_MAX_STEPS``
+    (close eigenvalues, slow convergence) get a full ``eigh``, so the answer is
+    always within the tolerance. Returns values (decreasing) and vectors.
+    """
+    m, d, _ = grams.shape
+    block = min(d, n_vectors + 4)
+    if 2 * block >= d:  # small matrices: the full decomposition costs no more
+        values, vectors = np.linalg.eigh(grams)
+        return values[:, ::-1][:, :n_vectors], vectors[:, :, ::-1][:, :, :n_vectors]
+    if n_vectors == 1:
+        start = grams.sum(axis=2, keepdims=True) + grams[:, :, :1]
+        start /= np.maximum(np.linalg.norm(start, axis=1, keepdims=True), np.finfo(float).tiny)
+        values, vectors, todo = _leading_pair(lambda rows, x: grams[rows] @ x, start)
+        if len(todo):
+            exact_values, exact_vectors = np.linalg.eigh(grams[todo])
+            values[todo], vectors[todo] = exact_values[:, -1:], exact_vectors[:, :, -1:]
+        return values, vectors
+    start = np.random.default_rng(0).standard_normal((d, block))  # fixed: reproducible
+    basis = np.linalg.qr(grams @ start)[0]
+    values = np.zeros((m, n_vectors))
+    vectors = np.zeros((m, d, n_vectors))
+    todo = np.arange(m)
+    for step in range(2, _MAX_STEPS + 1, 2):
+        # Two products per orthonormalisation: the QR costs more than a product,
+        # and the Gram matrices of unit-scaled clips keep G^2 X well within range.
+        active = grams[todo]
+        basis = np.linalg.qr(active @ (active @ basis))[0]
+        if step % _CHECK and step < _MAX_STEPS:
+            continue
+        product = active @ basis
+        ritz, rotation = np.linalg.eigh(np.swapaxes(basis, 1, 2) @ product)
+        rotation = rotation[:, :, ::-1][:, :, :n_vectors]
+        ritz = ritz[:, ::-1][:, :n_vectors]
+        candidate = basis @ rotation
+        residual = np.linalg.norm(product @ rotation - candidate * ritz[:, None, :], axis=1)
+        done = (residual <= _TOLERANCE * np.abs(ritz[:, :1])).all(axis=1)
+        values[todo[done]], vectors[todo[done]] = ritz[done], candidate[done]
+        todo, basis = todo[~done], basis[~done]
+        if not len(todo):
+            return values, vectors
+    exact_values, exact_vectors = np.linalg.eigh(grams[todo])
+    values[todo] = exact_values[:, ::-1][:, :n_vectors]
+    vectors[todo] = exact_vectors[:, :, ::-1][:, :, :n_vectors]
+    return values, vectors
+
+
+def _leading_pair(apply, start):
+    """The leading eigenpair of stacked symmetric PSD matrices ``G`` by power iteration.
+
+    ``apply(rows, x)`` is ``G[rows] @ x``. (Steps ``A^T (A x)`` on the clips,
+    without forming ``G``, were measured slower: numpy's stacked matrix-vector
+    products do not reach BLAS speed.) Uncentred motion clips have a
+    dominant first singular value (the mean posture), so plain power steps (a
+    product and a normalisation, no QR) converge in a few steps; the residual
+    is checked as in :func:`_leading_eigh`, and ``None`` marks the rows that did
+    not converge. Returns ``(values (m, 1), vectors (m, d, 1), unconverged rows)``.
+    """
+    m, d, _ = start.shape
+    values, vectors = np.zeros((m, 1)), np.zeros((m, d, 1))
+    todo, vector = np.arange(m), start
+    for step in range(1, 4 * _MAX_STEPS + 1):
+        product = apply(todo, vector)
+        if step % _CHECK == 0:
+            value = (vector * product).sum(axis=1)  # the Rayleigh quotient of unit vectors
+            residual = np.linalg.norm(product - vector * value[:, None, :], axis=1)
+            done = (residual[:, 0] <= _TOLERANCE * np.abs(value[:, 0])) & (step > 1)
+            values[todo[done]], vectors[todo[done]] = value[done], vector[done]
+            todo, product = todo[~done], product[~done]
+            if not len(todo):
+                break
+        norms = np.linalg.norm(product, axis=1, keepdims=True)
+        vector = product / np.maximum(norms, np.finfo(float).tiny)
+    return values, vectors, todo
+
+
+def _spectra_of_chunk(chunk, n_vectors, method):
     n = chunk[0].shape[1]
     eigenvalues = np.zeros((len(chunk), n))
     vectors = np.zeros((len(chunk), n, n_vectors))
     # The smaller Gram matrix of each clip: A^T A (channels x channels), or A A^T
-    # (frames x frames) for a clip with fewer frames than channels. Clips whose
-    # Gram matrices have one size are decomposed in one batched call.
-    sizes = np.array([min(len(c), n) for c in chunk])
-    for size in np.unique(sizes):
-        rows = np.flatnonzero(sizes == size)
-        clips = [np.asarray(chunk[i], dtype=np.float64) for i in rows]
-        tall = size == n
-        values, vecs = np.linalg.eigh(np.stack([c.T @ c if tall else c @ c.T for c in clips]))
-        values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
+    # (frames x frames) for a clip with fewer frames than channels. Clips of one
+    # length are stacked: their Gram matrices come from one batched product and
+    # are decomposed in one batched call.
+    lengths = np.array([len(c) for c in chunk])
+    for length in np.unique(lengths):
+        rows = np.flatnonzero(lengths == length)
+        clips = np.stack([np.asarray(chunk[i], dtype=np.float64) for i in rows])
+        peak = np.abs(clips).max(axis=(1, 2), keepdims=True)
+        clips = clips / np.where(peak > 0, peak, 1.0)  # see _unit_scale
+        tall = length >= n
+        grams = np.swapaxes(clips, 1, 2) @ clips if tall else clips @ np.swapaxes(clips, 1, 2)
+        if method == "iterative":
+            values, vecs = _leading_eigh(grams, min(n_vectors, grams.shape[1]))
+        else:
+            values, vecs = np.linalg.eigh(grams)
+            values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
         if not tall:
             # Right singular vectors from the left ones: v = A^T w / |A^T w|.
-            vecs = np.stack([c.T @ w for c, w in zip(clips, vecs)])
+            vecs = np.swapaxes(clips, 1, 2) @ vecs
             norms = np.linalg.norm(vecs, axis=1, keepdims=True)
             vecs = np.divide(vecs, norms, out=np.zeros_like(vecs), where=norms > 0)
-        eigenvalues[rows, :size] = values
+        eigenvalues[rows, : values.shape[1]] = values
         vectors[rows, :, : vecs.shape[2]] = vecs
     eigenvalues = np.clip(eigenvalues, 0.0, None)
     # Directions beyond a clip's rank are undefined: make them zero vectors, so
@@ -74,7 +180,7 @@ def _spectra_of_chunk(chunk, n_vectors):
     return eigenvalues, vectors
 
 
-def clip_spectra(clips, n_vectors, *, n_jobs=None):
+def clip_spectra(clips, n_vectors, *, method="exact", n_jobs=None):
     """Squared singular values and leading right singular vectors of each clip.
 
     Parameters
@@ -83,6 +189,11 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
         Validated clips (see :func:`skmotion.utils.check_clips`).
     n_vectors : int
         How many leading right singular vectors to return (at most ``n_channels``).
+    method : {"exact", "iterative"}, default="exact"
+        ``"exact"``: a full batched ``eigh`` of each Gram matrix, all eigenvalues.
+        ``"iterative"``: subspace iteration for the ``n_vectors`` leading pairs
+        only, each within ``1e-9 * lambda_1`` in residual (a full ``eigh``
+        otherwise); the eigenvalues beyond ``n_vectors`` are then returned as 0.
     n_jobs : int, default=None
         Number of jobs over chunks of clips; results do not depend on it.
 
@@ -90,7 +201,10 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     -------
     eigenvalues : ndarray of shape (n_clips, n_channels)
         Eigenvalues of each ``A^T A`` (the squared singular values of ``A``),
-        in decreasing order; zero beyond the clip's rank.
+        in decreasing order; zero beyond the clip's rank. ``A`` is the clip
+        divided by its largest absolute value: the vectors and the shares of the
+        eigenvalues are what depend on the clip, not its scale, and the scaled
+        Gram matrix neither overflows nor underflows for any finite clip.
     vectors : ndarray of shape (n_clips, n_channels, n_vectors)
         ``vectors[c, :, i]`` is the ``i``-th right singular vector of clip ``c``
         (unit norm, arbitrary sign), or zeros when ``i`` is at or beyond its rank.
@@ -101,7 +215,7 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     >>> from skmotion.decomposition._clip_svd import clip_spectra
     >>> A = np.array([[3.0, 0.0], [0.0, 1.0], [0.0, 0.0]])
     >>> values, vectors = clip_spectra([A], n_vectors=2)
-    >>> values.tolist()
+    >>> (values * 3.0**2).tolist()  # A / 3 was decomposed
     [[9.0, 1.0]]
     >>> np.abs(vectors[0]).tolist()
     [[1.0, 0.0], [0.0, 1.0]]
@@ -110,6 +224,6 @@ def clip_spectra(clips, n_vectors, *, n_jobs=None):
     chunks = [clips[i : i + _CHUNK] for i in range(0, len(clips), _CHUNK)]
     with small_blas():
         parts = parallel_map(
-            lambda chunk: _spectra_of_chunk(chunk, n_vectors), chunks, n_jobs=n_jobs
+            lambda chunk: _spectra_of_chunk(chunk, n_vectors, method), chunks, n_jobs=n_jobs
         )
     return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])

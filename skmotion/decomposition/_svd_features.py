@@ -7,44 +7,21 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
-from skmotion.decomposition._clip_svd import clip_spectra, small_blas
+from skmotion.decomposition._clip_svd import clip_spectra
+from skmotion.decomposition._svd_projection import (
+    N_VECTORS,
+    SVDProjection,
+    fit_svd_projection,
+    max_svd_components,
+    svd_project,
+)
 from skmotion.utils._clips import check_clips
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
-__all__ = ["SVDFeatureExtractor"]
+__all__ = ["SVDFeatureExtractor", "resolve_n_components"]
 
-_N_VECTORS = {"first": 1, "first_two": 2}
-
-
-def _orient(vector):
-    """Sign making the entry of largest magnitude positive (a fixed convention)."""
-    return 1.0 if vector[np.argmax(np.abs(vector))] >= 0 else -1.0
-
-
-def _right_singular(matrix, n):
-    """The ``n`` leading right singular vectors (rows) and singular values of a matrix.
-
-    With more rows (training clips) than columns, from the eigen-decomposition
-    of the small ``matrix^T matrix``: the left singular vectors, one entry per
-    clip, which an SVD would also compute, are never needed. Otherwise an SVD,
-    whose cost then follows the number of rows.
-    """
-    with small_blas():  # small problems: threads would only wait for each other
-        if matrix.shape[0] <= matrix.shape[1]:
-            _, singular, vt = np.linalg.svd(matrix, full_matrices=False)
-            return vt[:n], singular[:n]
-        values, vectors = np.linalg.eigh(matrix.T @ matrix)
-    return vectors[:, ::-1][:, :n].T, np.sqrt(np.clip(values[::-1][:n], 0.0, None))
-
-
-def _principal_axis(vectors):
-    """First principal axis (uncentred) of unit vectors, with a fixed sign.
-
-    ``sum_c v_c v_c^T`` does not change when any ``v_c`` flips sign, so the axis
-    is a property of the vectors' directions alone.
-    """
-    axis = _right_singular(vectors, 1)[0][0]
-    return axis * _orient(axis)
+# The length of the feature vectors when n_components is None (capped by the data).
+_DEFAULT_COMPONENTS = 8
 
 
 class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
@@ -66,10 +43,12 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
 
     Parameters
     ----------
-    n_components : int, default=8
+    n_components : int or None, default=None
         Length ``r`` of the feature vectors. At most the composite vector's
         length (``n_channels``, or ``2 * n_channels`` for ``"first_two"``) and
-        the number of training clips.
+        the number of training clips; a larger value is an error that names
+        the limit. None means 8, capped at that limit (so the default works on
+        6-channel data); ``n_components_`` holds the value used.
     weighting : {"first", "first_two"}, default="first"
         The first right singular vector alone, or the first two weighted by their
         share of the singular values.
@@ -79,9 +58,11 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
 
     Attributes
     ----------
-    components_ : ndarray of shape (n_components, n_composite)
+    n_components_ : int
+        Length of the feature vectors (``n_components``, or the capped default).
+    components_ : ndarray of shape (n_components_, n_composite)
         The rows are ``Z[:, :n_components]^T``.
-    singular_values_ : ndarray of shape (n_components,)
+    singular_values_ : ndarray of shape (n_components_,)
         The leading singular values of the stacked composite vectors.
     axes_ : ndarray of shape (n_vectors, n_channels)
         Sign references: each clip's ``u_i`` is flipped so that ``u_i . axes_[i]``
@@ -130,20 +111,20 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
     """
 
     _parameter_constraints = {
-        "n_components": [Interval(Integral, 1, None, closed="left")],
-        "weighting": [StrOptions(set(_N_VECTORS))],
+        "n_components": [Interval(Integral, 1, None, closed="left"), None],
+        "weighting": [StrOptions(set(N_VECTORS))],
         "n_jobs": [Integral, None],
     }
     _motion_tags = MotionTags(output_kind="table")
 
-    def __init__(self, n_components=8, *, weighting="first", n_jobs=None):
+    def __init__(self, n_components=None, *, weighting="first", n_jobs=None):
         self.n_components = n_components
         self.weighting = weighting
         self.n_jobs = n_jobs
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None):
-        """Learn the projection ``Z[:, :n_components]`` from the training clips.
+        """Learn the projection ``Z[:, :n_components_]`` from the training clips.
 
         Parameters
         ----------
@@ -159,8 +140,50 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
             The fitted transformer.
         """
         clips = check_clips(X, estimator=self, reset=True)
-        self._fit_spectra(*clip_spectra(clips, _N_VECTORS[self.weighting], n_jobs=self.n_jobs))
+        spectra = clip_spectra(clips, N_VECTORS[self.weighting], n_jobs=self.n_jobs)
+        n_components = resolve_n_components(
+            self.n_components, len(clips), clips.n_channels, self.weighting
+        )
+        self._set_projection(fit_svd_projection(*spectra, n_components, self.weighting))
         return self
+
+    @classmethod
+    def from_projection(cls, projection, n_features_in, *, n_jobs=None):
+        """A fitted extractor applying a projection fitted elsewhere.
+
+        Parameters
+        ----------
+        projection : SVDProjection
+            From :func:`~skmotion.decomposition.fit_svd_projection` (for example
+            the one :class:`~skmotion.neighbors.IntervalIndexNeighbors` learned).
+        n_features_in : int
+            Number of channels of the clips it was fitted on.
+        n_jobs : int, default=None
+            Number of jobs for the per-clip SVDs of :meth:`transform`.
+
+        Returns
+        -------
+        extractor : SVDFeatureExtractor
+            Fitted: its ``transform`` gives the projection's feature vectors.
+        """
+        extractor = cls(
+            n_components=len(projection.components), weighting=projection.weighting, n_jobs=n_jobs
+        )
+        extractor._set_projection(projection)
+        extractor.n_features_in_ = int(n_features_in)
+        return extractor
+
+    def _set_projection(self, projection):
+        self.axes_ = projection.axes
+        self.components_ = projection.components
+        self.singular_values_ = projection.singular_values
+        self.n_components_ = len(projection.components)
+
+    @property
+    def projection_(self):
+        """The fitted projection as an :class:`SVDProjection` (for :func:`svd_project`)."""
+        check_is_fitted(self)
+        return SVDProjection(self.weighting, self.axes_, self.components_, self.singular_values_)
 
     def transform(self, X):
         """Feature vectors of clips.
@@ -173,56 +196,13 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
 
         Returns
         -------
-        features : ndarray of shape (n_clips, n_components)
+        features : ndarray of shape (n_clips, n_components_)
             Or a DataFrame after ``set_output(transform="pandas")``.
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
-        spectra = clip_spectra(clips, _N_VECTORS[self.weighting], n_jobs=self.n_jobs)
-        return self._wrap_table(self._transform_spectra(*spectra), clips)
-
-    # -- the work, on precomputed spectra (IntervalIndexNeighbors shares them) --
-
-    def _composite(self, eigenvalues, vectors):
-        n_vectors = _N_VECTORS[self.weighting]
-        empty = np.flatnonzero(eigenvalues[:, 0] == 0)
-        if empty.size:
-            raise ValueError(
-                f"X: clip {empty[0]} is all zeros; it has no singular vectors, so "
-                "SVDFeatureExtractor cannot describe it."
-            )
-        u = vectors[:, :, :n_vectors]
-        signs = np.where(np.einsum("cni,in->ci", u, self.axes_) < 0, -1.0, 1.0)
-        u = u * signs[:, None, :]
-        if n_vectors == 1:
-            return u[:, :, 0]
-        singular = np.sqrt(eigenvalues)
-        weights = singular[:, :n_vectors] / singular.sum(axis=1, keepdims=True)
-        return np.concatenate(
-            [weights[:, i : i + 1] * u[:, :, i] for i in range(n_vectors)], axis=1
-        )
-
-    def _fit_spectra(self, eigenvalues, vectors):
-        n_vectors = _N_VECTORS[self.weighting]
-        n_clips, n_channels = eigenvalues.shape
-        limit = min(n_clips, n_vectors * n_channels)
-        if self.n_components > limit:
-            raise ValueError(
-                f"n_components={self.n_components} must be at most {limit}: the number "
-                f"of training clips ({n_clips}) and the length of the composite vectors "
-                f"({n_vectors * n_channels} for weighting={self.weighting!r})."
-            )
-        self.axes_ = np.stack([_principal_axis(vectors[:, :, i]) for i in range(n_vectors)])
-        composite = self._composite(eigenvalues, vectors)
-        components, singular = _right_singular(composite, self.n_components)
-        self.components_ = components * np.array([_orient(row) for row in components])[:, None]
-        self.singular_values_ = singular
-        return self
-
-    def _transform_spectra(self, eigenvalues, vectors):
-        features = self._composite(eigenvalues, vectors) @ self.components_.T
-        features *= np.where(features[:, :1] < 0, -1.0, 1.0)
-        return features
+        spectra = clip_spectra(clips, N_VECTORS[self.weighting], n_jobs=self.n_jobs)
+        return self._wrap_table(svd_project(self.projection_, *spectra), clips)
 
     def get_feature_names_out(self, input_features=None):
         """Output feature names ``svdfeatureextractor0, svdfeatureextractor1, ...``.
@@ -238,4 +218,11 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
         """
         check_is_fitted(self)
         prefix = type(self).__name__.lower()
-        return np.asarray([f"{prefix}{i}" for i in range(self.n_components)], dtype=object)
+        return np.asarray([f"{prefix}{i}" for i in range(self.n_components_)], dtype=object)
+
+
+def resolve_n_components(n_components, n_clips, n_channels, weighting):
+    """``n_components``, or for None the default capped at what the data allows."""
+    if n_components is None:
+        return min(_DEFAULT_COMPONENTS, max_svd_components(n_clips, n_channels, weighting))
+    return int(n_components)

@@ -273,7 +273,7 @@ class IntervalIndex:
         return node
 
     def _leaf_of_one(self, vector):
-        """The leaf of one query given as a list: ``bisect_right`` is ``searchsorted(side="right")``."""
+        """The leaf of one query given as a list (``bisect_right`` = ``searchsorted`` right)."""
         node = 1
         for edges, table, value in zip(self._edge_lists, self._tables, vector):
             node = table.item(node, bisect_right(edges, value))

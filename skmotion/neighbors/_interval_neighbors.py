@@ -3,93 +3,44 @@
 from numbers import Integral, Real
 
 import numpy as np
-import pandas as pd
-import scipy.sparse as sp
-from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.metrics.pairwise import euclidean_distances
+from sklearn.utils import check_random_state
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, column_or_1d, validate_data
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.decomposition import SVDFeatureExtractor
-from skmotion.decomposition._clip_svd import clip_spectra, small_blas
-from skmotion.decomposition._svd_features import _N_VECTORS
+from skmotion.decomposition._svd_projection import (
+    fit_svd_projection,
+    svd_project,
+)
+from skmotion.neighbors._describe import clip_level_limit, index_spectra, resolve_levels
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
+from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_k
+from skmotion.neighbors._store import GrowableStore
+from skmotion.neighbors._widths import learn_delta, radius_for_recall
 from skmotion.utils._clips import check_clips
-from skmotion.utils._parallel import parallel_map
-from skmotion.utils._sklearn_compat import Interval, _fit_context
+from skmotion.utils._progress import say
+from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
-__all__ = ["IntervalIndexNeighbors"]
+__all__ = ["IntervalIndexNeighbors", "learn_delta"]
 
 # Leaves ranked per parallel task: fixed, so results do not depend on n_jobs.
 _LEAVES_PER_TASK = 32
-
-
-def _is_table(X):
-    """A 2-D table of feature vectors rather than a clip collection?
-
-    Clips are a list or tuple of 2-D arrays, a 3-D array or a ``(clip, frame)``
-    DataFrame; anything else (a 2-D array, a list of 1-D rows, a plain DataFrame)
-    is a table.
-    """
-    if isinstance(X, (list, tuple)):
-        # All rows 1-D: a list with one 1-D clip among 2-D ones is a clip collection
-        # with a bad clip, which check_clips names.
-        return len(X) > 0 and all(np.ndim(x) == 1 for x in X)
-    if isinstance(X, np.ndarray):
-        return X.ndim != 3
-    if isinstance(X, pd.DataFrame):
-        return not isinstance(X.index, pd.MultiIndex)
-    # Array-likes are tables; anything else (None, a dict, a file name) goes to
-    # check_clips, whose TypeError names what was given.
-    return sp.issparse(X) or hasattr(X, "__array__")
-
-
-def learn_delta(features, labels, quantile):
-    """Per component, how far apart clips with the same label can be.
-
-    For each label with two or more clips, the range (max - min) of each
-    component over its clips; then the ``quantile`` of these ranges over the
-    labels. ``quantile=1`` is the maximum, the paper's ``delta_i``.
-    """
-    # One pass over the clips sorted by label (not one per label: a collection
-    # of repeated motions has about as many labels as clips).
-    _, codes, counts = np.unique(labels, return_inverse=True, return_counts=True)
-    order = np.argsort(codes.ravel(), kind="stable")
-    starts = np.r_[0, np.cumsum(counts)[:-1]]
-    ordered = features[order]
-    spreads = (
-        np.maximum.reduceat(ordered, starts, axis=0) - np.minimum.reduceat(ordered, starts, axis=0)
-    )[counts > 1]
-    if not len(spreads):
-        return np.zeros(features.shape[1])
-    return np.quantile(spreads, quantile, axis=0)
-
-
-def _extend(buffer, n, new):
-    """Write ``new`` after the first ``n`` rows of ``buffer``, growing it by doubling.
-
-    Insertions then cost amortised O(new rows), not a copy of everything stored.
-    """
-    need = n + len(new)
-    if buffer is None or need > len(buffer):
-        grown = np.empty(
-            (max(need, 2 * (0 if buffer is None else len(buffer))),) + new.shape[1:],
-            dtype=new.dtype,
-        )
-        if buffer is not None:
-            grown[:n] = buffer[:n]
-        buffer = grown
-    buffer[n:need] = new
-    return buffer
+# Levels of the tree when neither n_levels nor features.n_components is given.
+_DEFAULT_LEVELS = 7
+# The recall the entry widths are learned for when neither rule is given.
+_DEFAULT_RECALL = 0.99
 
 
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     """Similarity search and k-NN classification of clips through an interval index.
 
-    Fit computes each clip's SVD feature vector (:class:`SVDFeatureExtractor`
-    with ``n_components=n_levels``) and inserts it into an interval tree with one
+    Fit computes each clip's SVD feature vector (the projection of
+    :func:`~skmotion.decomposition.fit_svd_projection`, with ``n_levels_``
+    components) and inserts it into an interval tree with one
     level per component (Li & Prabhakaran). ``delta_i``, how far apart component
     ``i`` of two clips with the same label can be, is learned from ``y``; level
     ``i`` cuts the component's range into entries of width ``epsilon * delta_i``
@@ -99,17 +50,37 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     then ranked by the similarity :func:`psi` (distance ``1 - psi``).
 
     ``X`` may also be a 2-D array of feature vectors: the tree indexes its first
-    ``n_levels`` columns and candidates are ranked by Euclidean distance.
+    ``n_levels_`` columns and candidates are ranked by Euclidean distance.
 
     Parameters
     ----------
-    n_levels : int, default=7
-        Levels of the tree, i.e. feature components indexed.
-    epsilon : float, default=1.0
-        Entry interval factor: entry width and covering radius are
+    n_levels : int or None, default=None
+        Levels of the tree, i.e. feature components indexed. None means
+        ``features.n_components`` when that is set, else 7 capped at what the
+        data allows (the feature columns, or for clips the number of training
+        clips and the composite vector's length: 6 on 6-channel clips with
+        ``weighting="first"``); ``n_levels_`` holds the value used. An explicit
+        value the data cannot give is an error naming the limit.
+    target_recall : float in (0, 1] or None, default=None
+        Learn each level's radius (and entry width) so that this share of the
+        training clips' similar pairs survives the tree, pruning as much as
+        possible (see Notes). None means 0.99 unless ``epsilon`` is given.
+    epsilon : float or None, default=None
+        The paper's rule instead: entry width and covering radius are
         ``epsilon * delta_i``. With ``epsilon >= 1`` and ``delta_quantile=1``
         every stored clip with the query's label is a candidate when the query
-        is a stored clip (recall 1 by construction).
+        is a stored clip (recall 1 by construction). Giving both ``epsilon``
+        and ``target_recall`` is an error.
+    similar : {"labels", "psi"}, default="labels"
+        Which training pairs ``target_recall`` keeps: clips with the same label,
+        or each clip and its nearest other clip by psi (for clips whose labels
+        are classes rather than repetitions: then the pairs are the repetitions
+        psi finds, and the recall is that of the exact psi 1-NN).
+    width_factor : float, default=1.0
+        Entry width over covering radius. 1 is the paper's layout; wider
+        entries (2) put each clip into fewer leaves (about ``2**n_levels``
+        instead of ``3**n_levels``: less memory, faster insertion) at some cost
+        in pruning, which ``target_recall`` takes into account.
     max_entries : int, default=64
         The most entries a node may have; wider entries are used when capped.
     delta_quantile : float, default=1.0
@@ -121,23 +92,43 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     k : int, default=6
         Eigenvectors compared by :func:`psi` (clips only).
     features : SVDFeatureExtractor, default=None
-        The feature extractor (cloned, with ``n_components`` set to
-        ``n_levels``); None means ``SVDFeatureExtractor(weighting="first")``.
-        Use ``SVDFeatureExtractor(weighting="first_two")`` for the weighted
-        first two singular vectors.
+        Its ``weighting`` chooses the feature vectors; None means
+        ``SVDFeatureExtractor(weighting="first")``. Use
+        ``SVDFeatureExtractor(weighting="first_two")`` for the weighted first
+        two singular vectors. The tree has one level per feature component, so
+        its ``n_components`` (when not None) sets the number of levels; giving
+        both ``n_levels`` and a different ``features.n_components`` is an error.
     n_jobs : int, default=None
         Number of jobs for the SVDs and the ranking; results do not depend on it.
+    verbose : int, default=0
+        Print a line per stage of fit (decomposition, widths, tree) on
+        standard error when 1 or more; fit takes minutes at 10^5 clips.
+    random_state : int, RandomState instance or None, default=None
+        Draws the pairs ``target_recall`` learns from when there are more than
+        50,000 (and the anchors of ``similar="psi"``, at most 2,000).
 
     Attributes
     ----------
     classes_ : ndarray of shape (n_classes,)
         Class labels.
-    delta_ : ndarray of shape (n_levels,)
-        The learned ``delta_i``.
+    n_levels_ : int
+        Levels of the tree (= feature components indexed).
+    delta_ : ndarray of shape (n_levels_,)
+        The learned ``delta_i`` (the paper's rule).
+    radius_ : ndarray of shape (n_levels_,)
+        Covering radius (and entry width) of each level: ``epsilon * delta_``,
+        or learned for ``target_recall``.
+    width_rule_ : {"target_recall", "epsilon"}
+        Which rule set ``radius_``.
+    training_survival_ : float
+        With ``target_recall``: the share of random pairs of training clips
+        that survive the tree (1 - the pruning expected on such pairs).
     index_ : IntervalIndex
         The tree; stored clip ``j`` has id ``j``.
+    projection_ : SVDProjection or None
+        The fitted feature projection (None for feature-vector input).
     feature_extractor_ : SVDFeatureExtractor or None
-        The fitted extractor (None for feature-vector input).
+        An extractor applying ``projection_`` (None for feature-vector input).
     input_kind_ : {"clips", "table"}
         What fit was given.
     effective_metric_ : {"psi", "euclidean"}
@@ -158,6 +149,23 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     Notes
     -----
+    Entry widths. ``target_recall`` (the default, 0.99) learns the radii from
+    the training clips' similar pairs (same label, or psi nearest neighbours):
+    for a few shapes of the radii (per-level quantiles of the pairs'
+    component distances) the common scale is the smallest at which that share
+    of the pairs survives the tree (computed exactly, with the entries the tree
+    will have), and the shape that lets the fewest random training pairs
+    through is kept (``training_survival_``). The held-out recall is close to,
+    not guaranteed at, the target. ``epsilon`` gives the paper's rule instead.
+    Measured on held-out queries (``benchmarks/bench_neighbors_pruning.py``),
+    the learned widths prune more than ``epsilon=1.0`` at the same recall on
+    every development set.
+
+    Every clip is divided by its largest absolute value before its SVD: the
+    singular vectors, their energy shares and so psi and the feature vectors do
+    not depend on a clip's scale, and clips of any finite magnitude (1e-300 to
+    1e300) are described alike.
+
     A query whose leaf holds fewer than ``n_neighbors`` clips is ranked against
     all stored clips instead, so :meth:`kneighbors` always returns
     ``n_neighbors`` neighbours; :meth:`candidates` shows the pruned sets as they
@@ -177,8 +185,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     >>> data = make_motions(n_clips_per_class=6, random_state=0)
     >>> clips = [c[:, 6:] for c in data.clips]  # joint angles without the root
     >>> index = IntervalIndexNeighbors(n_levels=5, epsilon=1.0).fit(clips, data.target)
-    >>> index.n_samples_fit_, len(index.candidates(clips[:3]))
-    (42, 3)
+    >>> index.n_samples_fit_, index.n_levels_, len(index.candidates(clips[:3]))
+    (42, 5, 3)
     >>> distances, neighbours = index.kneighbors(n_neighbors=2)
     >>> neighbours.shape
     (42, 2)
@@ -187,37 +195,52 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     """
 
     _parameter_constraints = {
-        "n_levels": [Interval(Integral, 1, None, closed="left")],
-        "epsilon": [Interval(Real, 0, None, closed="neither")],
+        "n_levels": [Interval(Integral, 1, None, closed="left"), None],
+        "target_recall": [Interval(Real, 0, 1, closed="right"), None],
+        "epsilon": [Interval(Real, 0, None, closed="neither"), None],
+        "similar": [StrOptions({"labels", "psi"})],
+        "width_factor": [Interval(Real, 0, None, closed="neither")],
         "max_entries": [Interval(Integral, 1, None, closed="left")],
         "delta_quantile": [Interval(Real, 0, 1, closed="right")],
         "n_neighbors": [Interval(Integral, 1, None, closed="left")],
         "k": [Interval(Integral, 1, None, closed="left")],
         "features": [SVDFeatureExtractor, None],
         "n_jobs": [Integral, None],
+        "verbose": ["verbose"],
+        "random_state": ["random_state"],
     }
     _motion_tags = MotionTags(output_kind="labels")
 
     def __init__(
         self,
-        n_levels=7,
+        n_levels=None,
         *,
-        epsilon=1.0,
+        target_recall=None,
+        epsilon=None,
+        similar="labels",
+        width_factor=1.0,
         max_entries=64,
         delta_quantile=1.0,
         n_neighbors=1,
         k=6,
         features=None,
         n_jobs=None,
+        verbose=0,
+        random_state=None,
     ):
         self.n_levels = n_levels
+        self.target_recall = target_recall
         self.epsilon = epsilon
+        self.similar = similar
+        self.width_factor = width_factor
         self.max_entries = max_entries
         self.delta_quantile = delta_quantile
         self.n_neighbors = n_neighbors
         self.k = k
         self.features = features
         self.n_jobs = n_jobs
+        self.verbose = verbose
+        self.random_state = random_state
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
@@ -226,32 +249,51 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     # -- input -------------------------------------------------------------------
 
-    def _describe(self, X, *, reset):
-        """Validate ``X`` once; return (tree features, ranking data)."""
+    def _describe(self, X, *, reset, ranking=True):
+        """Validate ``X`` once; return (feature vectors, ranking data or None).
+
+        Without ranking (candidate sets only) a clip needs only its first
+        singular vector(s), not the ``k`` eigenvectors of psi.
+        """
+        kind = input_kind(X)
         if reset:
-            self.input_kind_ = "table" if _is_table(X) else "clips"
-        elif ("table" if _is_table(X) else "clips") != self.input_kind_:
+            self.input_kind_ = kind
+        elif kind != self.input_kind_:
             expected = "a 2-D array of feature vectors" if self.input_kind_ == "table" else "clips"
             raise ValueError(
                 f"X: {type(self).__name__} was fitted on {expected}; pass the same kind."
             )
         if self.input_kind_ == "table":
             table = validate_data(self, X, reset=reset, dtype=np.float64)
-            return table, table
+            if reset:
+                self.n_levels_ = self._resolve_levels(table.shape[1], "feature(s) of X")
+            return table[:, : self.n_levels_], table
         clips = check_clips(X, estimator=self, reset=reset)
-        extractor = self._extractor() if reset else self.feature_extractor_
-        n_vectors = max(min(self.k, clips.n_channels), _N_VECTORS[extractor.weighting])
-        eigenvalues, vectors = clip_spectra(clips, n_vectors, n_jobs=self.n_jobs)
+        weighting = self._weighting()
+        spectra = index_spectra(clips, weighting, self.k if ranking else 0, n_jobs=self.n_jobs)
         if reset:
-            extractor._fit_spectra(eigenvalues, vectors)
-            extractor.n_features_in_ = clips.n_channels
-            self.feature_extractor_ = extractor
-        features = extractor._transform_spectra(eigenvalues, vectors)
-        return features, signatures_from_spectra(eigenvalues, vectors, self.k)
+            self.n_levels_ = self._resolve_levels(*clip_level_limit(clips, weighting))
+            self.projection_ = fit_svd_projection(*spectra, self.n_levels_, weighting)
+        tree = svd_project(self.projection_, *spectra)
+        return tree, signatures_from_spectra(*spectra, self.k) if ranking else None
 
-    def _extractor(self):
-        base = SVDFeatureExtractor() if self.features is None else self.features
-        return clone(base).set_params(n_components=self.n_levels, n_jobs=self.n_jobs)
+    def _weighting(self):
+        return "first" if self.features is None else self.features.weighting
+
+    def _resolve_levels(self, limit, what):
+        """``n_levels_``: the levels asked for, or the capped default (see ``n_levels``)."""
+        from_features = None if self.features is None else self.features.n_components
+        return resolve_levels(self.n_levels, from_features, limit, what, _DEFAULT_LEVELS)
+
+    @property
+    def feature_extractor_(self):
+        """A fitted :class:`SVDFeatureExtractor` giving this index's feature vectors."""
+        check_is_fitted(self)
+        if self.input_kind_ == "table":
+            return None
+        return SVDFeatureExtractor.from_projection(
+            self.projection_, self.n_features_in_, n_jobs=self.n_jobs
+        )
 
     def _check_labels(self, y, n, *, known=False):
         # Labels that must be among classes_ (known=True) are checked against
@@ -287,59 +329,89 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         return self._fit(X, y)
 
     def _fit(self, X, y, classes=None):
-        features, ranking = self._describe(X, reset=True)
-        y = self._check_labels(y, len(features))
-        if self.input_kind_ == "table" and features.shape[1] < self.n_levels:
-            raise ValueError(
-                f"n_levels={self.n_levels} needs feature vectors with at least that many "
-                f"columns; X has {features.shape[1]} feature(s)."
-            )
+        say(self.verbose, f"{type(self).__name__}: decomposing the clips")
+        tree_features, ranking = self._describe(X, reset=True)
+        y = self._check_labels(y, len(tree_features))
+        if self.input_kind_ == "table":
+            self.projection_ = None
+        self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
         self.classes_ = np.unique(y if classes is None else classes)
         self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
-        tree_features = features[:, : self.n_levels]
-        self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
-        radius = self.epsilon * self.delta_
-        low, high = tree_features.min(axis=0), tree_features.max(axis=0)
-        edges = [
-            entry_edges(low[i], high[i], radius[i], self.max_entries) for i in range(self.n_levels)
-        ]
-        self.index_ = IntervalIndex(edges, radius)
+        say(self.verbose, f"{type(self).__name__}: learning the entry widths")
+        self.index_ = IntervalIndex(*self._layout(tree_features, encoded, ranking))
+        say(self.verbose, f"{type(self).__name__}: building the tree ({self.n_levels_} levels)")
         self.index_.insert(tree_features)
-        self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
-        self.n_samples_fit_ = 0
-        self._buffers = None
+        names = ("weights", "vectors") if self.effective_metric_ == "psi" else ("table",)
+        self._stored = GrowableStore(("tree", "encoded", "labels") + names)
         self._store(tree_features, ranking, encoded)
         return self
 
+    def _layout(self, tree_features, encoded, ranking):
+        """Learn ``delta_`` and ``radius_``; return the tree's (edges, radius).
+
+        The layout depends on the training feature vectors and labels only (and
+        on psi signatures for ``similar="psi"``), so a sharded index learns it
+        once and every shard uses it.
+        """
+        self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
+        radius = self.radius_ = self._radius(tree_features, encoded, ranking)
+        low, high = tree_features.min(axis=0), tree_features.max(axis=0)
+        edges = [
+            entry_edges(low[i], high[i], self.width_factor * radius[i], self.max_entries)
+            for i in range(len(radius))
+        ]
+        return edges, radius
+
+    def _radius(self, tree_features, encoded, ranking):
+        """Each level's radius by the paper's rule or learned for the recall asked."""
+        if self.epsilon is not None and self.target_recall is not None:
+            raise ValueError(
+                f"epsilon={self.epsilon} and target_recall={self.target_recall}: give one rule "
+                "for the entry widths (epsilon: the paper's epsilon * delta_i; target_recall: "
+                "learned from the similar pairs)."
+            )
+        if self.epsilon is not None:
+            self.width_rule_ = "epsilon"
+            return self.epsilon * self.delta_
+        if self.similar == "psi" and self.effective_metric_ != "psi":
+            raise ValueError('similar="psi" needs clips; X is a table of feature vectors.')
+        self.width_rule_ = "target_recall"
+        radius, self.training_survival_ = radius_for_recall(
+            tree_features,
+            encoded if self.similar == "labels" else ranking,
+            _DEFAULT_RECALL if self.target_recall is None else self.target_recall,
+            check_random_state(self.random_state),
+            max_entries=self.max_entries,
+            width_factor=self.width_factor,
+            n_jobs=self.n_jobs,
+        )
+        return radius
+
     def _store(self, tree_features, ranking, encoded):
         """Append clips' tree features, ranking data and labels to the stored ones."""
-        labels = self.classes_[encoded]
-        new = (
-            tree_features,
-            encoded,
-            labels,
-            *(ranking if isinstance(ranking, tuple) else (ranking,)),
+        ranking = ranking if isinstance(ranking, tuple) else (ranking,)
+        parts = dict(zip(self._stored.names[3:], ranking))
+        self._stored.append(
+            tree=tree_features, encoded=encoded, labels=self.classes_[encoded], **parts
         )
-        old = self._buffers or (None,) * len(new)
-        n = self.n_samples_fit_
-        self._buffers = tuple(_extend(b, n, a) for b, a in zip(old, new))
-        self.n_samples_fit_ = n + len(tree_features)
-        self.labels_ = self._buffers[2][: self.n_samples_fit_]  # a view: O(1) per insertion
+        self.n_samples_fit_ = len(self._stored)
+        self.labels_ = self._stored["labels"]  # a view: O(1) per insertion
 
     @property
     def _tree_features(self):
-        return self._buffers[0][: self.n_samples_fit_]
+        return self._stored["tree"]
 
     @property
     def _encoded(self):
-        return self._buffers[1][: self.n_samples_fit_]
+        return self._stored["encoded"]
 
     @property
     def _ranking(self):
         """Signatures (weights, vectors) for psi, or the feature vectors."""
-        parts = tuple(b[: self.n_samples_fit_] for b in self._buffers[3:])
-        return parts if self.effective_metric_ == "psi" else parts[0]
+        if self.effective_metric_ == "psi":
+            return self._stored["weights"], self._stored["vectors"]
+        return self._stored["table"]
 
     def insert(self, X, y):
         """Add clips to the fitted index, without rebuilding it.
@@ -359,11 +431,10 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             The index, now holding the new clips.
         """
         check_is_fitted(self)
-        features, ranking = self._describe(X, reset=False)
-        y = self._check_labels(y, len(features), known=True)
+        tree_features, ranking = self._describe(X, reset=False)
+        y = self._check_labels(y, len(tree_features), known=True)
         self._check_known(y)
         encoded = np.searchsorted(self.classes_, y)
-        tree_features = features[:, : self.n_levels]
         self.index_.insert(tree_features)
         self._store(tree_features, ranking, encoded)
         return self
@@ -405,13 +476,13 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     # -- queries -------------------------------------------------------------------
 
-    def _queries(self, X):
+    def _queries(self, X, ranking=True):
         """(tree features, ranking data, self ids or None) of the queries."""
         check_is_fitted(self)
         if X is None:
             return self._tree_features, self._ranking, np.arange(self.n_samples_fit_)
-        features, ranking = self._describe(X, reset=False)
-        return features[:, : self.n_levels], ranking, None
+        tree_features, ranking = self._describe(X, reset=False, ranking=ranking)
+        return tree_features, ranking, None
 
     def candidates(self, X=None):
         """The pruned candidate set of each query: ids of the clips in its leaf.
@@ -427,7 +498,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             Sorted ids of stored clips (positions in the fitted collection, then
             inserted clips), one array per query.
         """
-        features, _, self_ids = self._queries(X)
+        features, _, self_ids = self._queries(X, ranking=False)
         found = self.index_.candidates(features)
         if self_ids is not None:
             found = [c[c != i] for c, i in zip(found, self_ids)]
@@ -450,16 +521,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         distances = self._distances(ranking, rows, columns)
         if self_ids is not None:
             distances[columns[None, :] == self_ids[rows][:, None]] = np.inf
-        if columns.size > 4 * n_neighbors:
-            part = np.argpartition(distances, n_neighbors - 1, axis=1)[:, :n_neighbors]
-            part.sort(axis=1)  # equal distances: the lower id first
-        else:
-            part = np.broadcast_to(np.arange(columns.size), distances.shape)
-        order = np.argsort(np.take_along_axis(distances, part, axis=1), axis=1, kind="stable")[
-            :, :n_neighbors
-        ]
-        chosen = np.take_along_axis(part, order, axis=1)
-        return rows, np.take_along_axis(distances, chosen, axis=1), columns[chosen]
+        chosen, nearest = smallest_k(distances, n_neighbors)
+        return nearest, columns[chosen]
 
     def kneighbors(self, X=None, n_neighbors=None, return_distance=True):
         """The nearest stored clips of each query, among its candidates.
@@ -489,24 +552,13 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
                 f"n_neighbors must be an integer from 1 to {available} (the stored clips"
                 f"{' other than the query' if self_ids is not None else ''}); got {n_neighbors!r}."
             )
-        leaves = self.index_.leaf_of(features)
-        order = np.argsort(leaves, kind="stable")
-        bounds = np.flatnonzero(np.r_[True, leaves[order][1:] != leaves[order][:-1], True])
-        groups = [(leaves[order[a]], order[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
-        tasks = [groups[i : i + _LEAVES_PER_TASK] for i in range(0, len(groups), _LEAVES_PER_TASK)]
-
-        def rank(task):
-            return [
-                self._rank_leaf(leaf, rows, ranking, self_ids, n_neighbors) for leaf, rows in task
-            ]
-
-        distances = np.empty((len(features), n_neighbors))
-        indices = np.empty((len(features), n_neighbors), dtype=np.intp)
-        with small_blas():
-            ranked = parallel_map(rank, tasks, n_jobs=self.n_jobs)
-        for part in ranked:
-            for rows, dist, ind in part:
-                distances[rows], indices[rows] = dist, ind
+        distances, indices = nearest_in_leaves(
+            self.index_.leaf_of(features),
+            lambda leaf, rows: self._rank_leaf(leaf, rows, ranking, self_ids, n_neighbors),
+            n_neighbors,
+            leaves_per_task=_LEAVES_PER_TASK,
+            n_jobs=self.n_jobs,
+        )
         return (distances, indices) if return_distance else indices
 
     def predict_proba(self, X):

@@ -7,7 +7,14 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from skmotion.datasets import make_motions
-from skmotion.decomposition import SVDFeatureExtractor
+from skmotion.decomposition import (
+    SVDFeatureExtractor,
+    fit_svd_projection,
+    max_svd_components,
+    svd_project,
+)
+from skmotion.decomposition._clip_svd import clip_spectra
+from skmotion.decomposition._svd_projection import _composite
 from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 
 
@@ -79,14 +86,48 @@ def test_composite_weights_are_singular_value_shares():
     # A clip whose right singular vectors are the axes, singular values 3, 2, 1.
     clip = np.diag([3.0, 2.0, 1.0])
     extractor = SVDFeatureExtractor(n_components=1, weighting="first_two").fit([clip, clip])
-    composite = extractor._composite(*_spectra([clip]))
+    composite = _composite(*clip_spectra([clip], 2), extractor.axes_, "first_two")
     np.testing.assert_allclose(np.abs(composite), [[0.5, 0, 0, 0, 1 / 3, 0]], atol=1e-12)
 
 
-def _spectra(clips):
-    from skmotion.decomposition._clip_svd import clip_spectra
+@pytest.mark.parametrize("weighting", ["first", "first_two"])
+def test_public_projection_functions_are_what_the_extractor_computes(weighting):
+    clips, _ = _data()
+    extractor = SVDFeatureExtractor(n_components=4, weighting=weighting).fit(clips)
+    spectra = clip_spectra(clips, 2)
+    projection = fit_svd_projection(*spectra, 4, weighting)
+    np.testing.assert_allclose(projection.components, extractor.components_, atol=1e-12)
+    expected = extractor.transform(clips)
+    np.testing.assert_allclose(svd_project(projection, *spectra), expected, atol=1e-12)
+    again = SVDFeatureExtractor.from_projection(extractor.projection_, clips[0].shape[1])
+    np.testing.assert_array_equal(again.transform(clips), expected)
 
-    return clip_spectra(clips, 2)
+
+def test_default_length_is_capped_on_six_channel_data():
+    # BasicMotions-shaped: 6 channels (accelerometer + gyroscope), 100 frames.
+    rng = np.random.default_rng(0)
+    clips = [rng.normal(size=(100, 6)) * rng.uniform(0.5, 2, size=6) for _ in range(12)]
+    extractor = SVDFeatureExtractor().fit(clips)
+    assert extractor.n_components_ == max_svd_components(12, 6, "first") == 6
+    assert extractor.transform(clips).shape == (12, 6)
+    assert len(extractor.get_feature_names_out()) == 6
+    two = SVDFeatureExtractor(weighting="first_two").fit(clips)
+    assert two.n_components_ == 8  # the default fits in 2 x 6
+    few = SVDFeatureExtractor().fit(clips[:3])
+    assert few.n_components_ == 3  # capped at the training clips
+    with pytest.raises(ValueError, match=r"n_components=7 must be at most 6.*Pass n_components=6"):
+        SVDFeatureExtractor(n_components=7).fit(clips)
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-100, 1e100, 1e300])
+def test_features_do_not_depend_on_the_clips_scale(scale):
+    clips, _ = _data()
+    extractor = SVDFeatureExtractor(n_components=4, weighting="first_two").fit(clips)
+    expected = extractor.transform(clips)
+    scaled = [c * scale for c in clips]
+    np.testing.assert_allclose(extractor.transform(scaled), expected, atol=1e-10)
+    refit = SVDFeatureExtractor(n_components=4, weighting="first_two").fit(scaled)
+    np.testing.assert_allclose(refit.transform(scaled), expected, atol=1e-10)
 
 
 clip_strategy = arrays(

@@ -141,7 +141,8 @@ def test_kneighbors_with_all_candidates_is_the_brute_force_psi_ranking(repeated)
     reference = 1 - pairwise_psi(queries, clips)
     order = np.argsort(reference, axis=1, kind="stable")[:, :5]
     np.testing.assert_array_equal(neighbours, order)
-    np.testing.assert_allclose(distances, np.take_along_axis(reference, order, axis=1), atol=1e-12)
+    # The index finds the leading eigenpairs iteratively (residual <= 1e-9 of the largest).
+    np.testing.assert_allclose(distances, np.take_along_axis(reference, order, axis=1), atol=1e-8)
     # X=None: every stored clip against the others.
     distances, neighbours = index.kneighbors(n_neighbors=3)
     loo = 1 - pairwise_psi(clips)
@@ -226,7 +227,7 @@ def test_insert_and_query_errors(repeated):
         index.kneighbors(clips[:2], n_neighbors=len(clips) + 1)
     with pytest.raises(ValueError, match="y has 3 labels"):
         IntervalIndexNeighbors(n_levels=3).fit(clips, target[:3])
-    with pytest.raises(ValueError, match="n_levels=7 needs feature vectors with at least"):
+    with pytest.raises(ValueError, match=r"n_levels=7 is more than the 3 feature\(s\) of X"):
         IntervalIndexNeighbors(n_levels=7).fit(np.zeros((5, 3)), [0, 0, 1, 1, 1])
 
 
@@ -245,7 +246,7 @@ def test_grid_search_over_epsilon_and_n_levels_with_the_scorers(repeated):
         cv=GroupKFold(4),
     ).fit(clips, target, groups=groups)
     results = search.cv_results_
-    for i, params in enumerate(results["params"]):
+    for i in range(len(results["params"])):
         pruning, found = results["mean_test_pruning"][i], results["mean_test_recall"][i]
         assert 0 <= pruning <= 1 and 0 <= found <= 1
     # epsilon widens the entries: more candidates, less pruning, more recall.
@@ -265,3 +266,75 @@ def test_on_uea_data(shared_data):
     assert recall(index.candidates(), train.target, train.target, query_ids=ids) == 1.0
     # 1-NN by psi among the candidates recognises the held-out recordings.
     assert index.score(test.clips, test.target) >= 0.8
+
+
+def _six_channel_data(n_per_class=8, random_state=0):
+    """BasicMotions-shaped: 4 classes, 6 channels (accelerometer + gyroscope), 100 frames."""
+    rng = np.random.default_rng(random_state)
+    t = np.linspace(0, 2 * np.pi, 100)[:, None]
+    clips, labels = [], []
+    for label in range(4):
+        freq = rng.uniform(1, 4, size=6)
+        gain = rng.uniform(0.2, 2.0, size=6)
+        for _ in range(n_per_class):
+            wave = np.sin((label + 1) * freq * t + rng.uniform(0, 0.3, size=6)) * gain
+            clips.append(wave + 0.05 * rng.normal(size=wave.shape))
+            labels.append(label)
+    return clips, np.array(labels)
+
+
+def test_defaults_adapt_to_six_channel_data():
+    clips, labels = _six_channel_data()
+    index = IntervalIndexNeighbors().fit(clips, labels)
+    # 7 levels asked by default; the first singular vector of 6 channels gives 6 components.
+    assert index.n_levels_ == 6 and index.index_.n_levels == 6
+    assert index.feature_extractor_.n_components_ == 6
+    assert index.score(clips, labels) == 1.0
+    two = IntervalIndexNeighbors(features=SVDFeatureExtractor(weighting="first_two"))
+    assert two.fit(clips, labels).n_levels_ == 7
+    with pytest.raises(ValueError, match=r"n_levels=7 is more than the 6 SVD feature components"):
+        IntervalIndexNeighbors(n_levels=7).fit(clips, labels)
+
+
+def test_levels_come_from_n_levels_or_features_never_silently_overridden():
+    clips, labels = _six_channel_data(n_per_class=4)
+    by_features = IntervalIndexNeighbors(features=SVDFeatureExtractor(n_components=3))
+    assert by_features.fit(clips, labels).n_levels_ == 3
+    both = IntervalIndexNeighbors(n_levels=4, features=SVDFeatureExtractor(n_components=4))
+    assert both.fit(clips, labels).n_levels_ == 4
+    with pytest.raises(ValueError, match=r"n_levels=2 and features.n_components=5 disagree"):
+        IntervalIndexNeighbors(n_levels=2, features=SVDFeatureExtractor(n_components=5)).fit(
+            clips, labels
+        )
+    # The index's feature vectors are the public projection's, as a lone extractor gives them.
+    alone = SVDFeatureExtractor(n_components=3).fit(clips)
+    np.testing.assert_allclose(
+        by_features.feature_extractor_.transform(clips), alone.transform(clips), atol=1e-12
+    )
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e300])
+def test_extreme_but_finite_clips_give_the_same_answers(repeated, scale):
+    clips, target = repeated
+    index = IntervalIndexNeighbors(n_levels=4, n_neighbors=3).fit(clips, target)
+    scaled = [c * scale for c in clips]
+    big = IntervalIndexNeighbors(n_levels=4, n_neighbors=3).fit(scaled, target)
+    np.testing.assert_allclose(big.delta_, index.delta_, atol=1e-10)
+    np.testing.assert_array_equal(
+        big.kneighbors(return_distance=False), index.kneighbors(return_distance=False)
+    )
+    # Mixed scales: a scaled query finds what the plain query finds.
+    distances, found = index.kneighbors(scaled[:5])
+    expected_distances, expected = index.kneighbors(clips[:5])
+    np.testing.assert_array_equal(found, expected)
+    np.testing.assert_allclose(distances, expected_distances, atol=1e-10)
+
+
+def test_verbose_reports_the_stages_of_fit_and_is_silent_by_default(repeated, capsys):
+    clips, target = repeated
+    IntervalIndexNeighbors(n_levels=3).fit(clips, target)
+    assert capsys.readouterr().err == ""
+    IntervalIndexNeighbors(n_levels=3, verbose=1).fit(clips, target)
+    err = capsys.readouterr().err
+    for stage in ("decomposing the clips", "learning the entry widths", "building the tree"):
+        assert stage in err

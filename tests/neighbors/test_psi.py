@@ -14,9 +14,9 @@ from skmotion.neighbors import pairwise_psi, psi
 def psi_by_definition(Q, P, k):
     """Written from the formula with np.linalg.eigh on Q^T Q and P^T P."""
     s, U = np.linalg.eigh(Q.T @ Q)
-    l, V = np.linalg.eigh(P.T @ P)
-    s, U, l, V = s[::-1][:k], U[:, ::-1][:, :k], l[::-1][:k], V[:, ::-1][:, :k]
-    return 0.5 * sum((s[i] / s.sum() + l[i] / l.sum()) * abs(U[:, i] @ V[:, i]) for i in range(k))
+    t, V = np.linalg.eigh(P.T @ P)
+    s, U, t, V = s[::-1][:k], U[:, ::-1][:, :k], t[::-1][:k], V[:, ::-1][:, :k]
+    return 0.5 * sum((s[i] / s.sum() + t[i] / t.sum()) * abs(U[:, i] @ V[:, i]) for i in range(k))
 
 
 def test_hand_worked():

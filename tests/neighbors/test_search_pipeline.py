@@ -1,4 +1,4 @@
-"""DESIGN.md's similarity-search pipeline: virtual markers into the interval index, grid-searched."""
+"""The similarity-search pipeline: virtual markers into the interval index, grid-searched."""
 
 import numpy as np
 import pytest

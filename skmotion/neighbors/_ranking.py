@@ -1,0 +1,92 @@
+"""Input kinds and the ranking of candidates, for IntervalIndexNeighbors."""
+
+import numpy as np
+import pandas as pd
+import scipy.sparse as sp
+
+from skmotion.decomposition._clip_svd import small_blas
+from skmotion.utils._parallel import parallel_map
+
+__all__ = ["input_kind", "nearest_in_leaves", "smallest_k"]
+
+
+def input_kind(X):
+    """``"table"`` for a 2-D table of feature vectors, else ``"clips"``.
+
+    Clips are a list or tuple of 2-D arrays, a 3-D array or a ``(clip, frame)``
+    DataFrame; anything else (a 2-D array, a list of 1-D rows, a plain
+    DataFrame) is a table. Objects that are neither go to ``check_clips``, whose
+    TypeError names what was given.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.neighbors._ranking import input_kind
+    >>> input_kind(np.zeros((4, 3))), input_kind([np.zeros((5, 3))]), input_kind(None)
+    ('table', 'clips', 'clips')
+    """
+    if isinstance(X, (list, tuple)):
+        # All rows 1-D: a list with one 1-D clip among 2-D ones is a clip collection
+        # with a bad clip, which check_clips names.
+        table = len(X) > 0 and all(np.ndim(x) == 1 for x in X)
+    elif isinstance(X, np.ndarray):
+        table = X.ndim != 3
+    elif isinstance(X, pd.DataFrame):
+        table = not isinstance(X.index, pd.MultiIndex)
+    else:
+        table = sp.issparse(X) or hasattr(X, "__array__")
+    return "table" if table else "clips"
+
+
+def smallest_k(distances, n):
+    """Per row, the columns of the ``n`` smallest distances, ties by column.
+
+    Returns ``(columns, distances)``, both ``(n_rows, n)``, increasing.
+    """
+    if distances.shape[1] > 4 * n:
+        part = np.argpartition(distances, n - 1, axis=1)[:, :n]
+        part.sort(axis=1)  # equal distances: the lower column first
+    else:
+        part = np.broadcast_to(np.arange(distances.shape[1]), distances.shape)
+    order = np.argsort(np.take_along_axis(distances, part, axis=1), axis=1, kind="stable")[:, :n]
+    chosen = np.take_along_axis(part, order, axis=1)
+    return chosen, np.take_along_axis(distances, chosen, axis=1)
+
+
+def nearest_in_leaves(leaves, rank_leaf, n_neighbors, *, leaves_per_task=32, n_jobs=None):
+    """k nearest neighbours of queries, ranking each leaf's queries together.
+
+    Parameters
+    ----------
+    leaves : ndarray of shape (n_queries,)
+        The leaf each query reached.
+    rank_leaf : callable
+        ``rank_leaf(leaf, rows) -> (distances, ids)`` of shape
+        ``(len(rows), n_neighbors)`` for the queries ``rows`` of one leaf.
+    n_neighbors : int
+    leaves_per_task : int, default=32
+        Leaves ranked per parallel task: fixed, so results do not depend on ``n_jobs``.
+    n_jobs : int, default=None
+        Number of jobs over the tasks.
+
+    Returns
+    -------
+    distances, indices : ndarray of shape (n_queries, n_neighbors)
+    """
+    order = np.argsort(leaves, kind="stable")
+    bounds = np.flatnonzero(np.r_[True, leaves[order][1:] != leaves[order][:-1], True])
+    groups = [(leaves[order[a]], order[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
+    step = leaves_per_task
+    tasks = [groups[i : i + step] for i in range(0, len(groups), step)]
+
+    def rank(task):
+        return [(rows, *rank_leaf(leaf, rows)) for leaf, rows in task]
+
+    distances = np.empty((len(leaves), n_neighbors))
+    indices = np.empty((len(leaves), n_neighbors), dtype=np.intp)
+    with small_blas():
+        ranked = parallel_map(rank, tasks, n_jobs=n_jobs)
+    for part in ranked:
+        for rows, dist, ind in part:
+            distances[rows], indices[rows] = dist, ind
+    return distances, indices
