@@ -6,7 +6,7 @@ import numpy as np
 
 from skmotion.io._errors import MotionFileError
 from skmotion.io._motion import Motion
-from skmotion.io._text import Tokens, parse_floats, read_bytes
+from skmotion.io._text import Tokens, parse_floats, read_text
 from skmotion.kinematics import Skeleton
 
 __all__ = ["read_amc"]
@@ -20,7 +20,7 @@ def _header(path, data):
     if found is None:
         raise MotionFileError(path, None, "no frame number: the file holds no frames")
     unit = None
-    for number, line in enumerate(data[: found.start()].decode("latin-1").splitlines(), start=1):
+    for number, line in enumerate(data[: found.start()].decode("latin-1").split("\n"), start=1):
         word = line.strip()
         if not word or word.startswith("#"):
             continue
@@ -142,7 +142,7 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
         raise TypeError(
             f"skeleton must be a Skeleton (from read_asf), got {type(skeleton).__name__}."
         )
-    data = read_bytes(path)
+    data = read_text(path)
     unit, start, first_line = _header(path, data)
     tokens = Tokens(data[start:], first_line=first_line)
     buffer = np.frombuffer(tokens.data, dtype=np.uint8)
@@ -182,7 +182,8 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
         raise MotionFileError(
             path,
             int(tokens.lines[k]),
-            f"bone {skeleton.joints[j]!r} has {per_line[~is_frame][bad[0]] - 1} values, but its dof has {counts[j]}",
+            f"bone {skeleton.joints[j]!r} has {per_line[~is_frame][bad[0]] - 1} values, "
+            f"but its dof has {counts[j]}",
         )
 
     # Frame numbers, and which frame each bone line belongs to.
@@ -190,13 +191,18 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     value_index = np.cumsum(~named) - 1  # position of each numeric token in ``values``
     frame_numbers = values[value_index[lead_tokens[is_frame]]]
     frame_lines = tokens.lines[lead_tokens[is_frame]]
+    if len(frame_numbers) and not (frame_numbers[0] >= 0 and frame_numbers[0] % 1 == 0):
+        raise MotionFileError(
+            path, int(frame_lines[0]), f"frame number {frame_numbers[0]:g} is not a whole number"
+        )
     steps = np.diff(frame_numbers)
     if (steps != 1).any():
         k = int(np.flatnonzero(steps != 1)[0]) + 1
         raise MotionFileError(
             path,
             int(frame_lines[k]),
-            f"frame number {frame_numbers[k]:g} follows {frame_numbers[k - 1]:g}; frames must count up by one",
+            f"frame number {frame_numbers[k]:g} follows {frame_numbers[k - 1]:g}; "
+            "frames must count up by one",
         )
     n_frames = len(frame_numbers)
     frame_of_line = np.cumsum(is_frame) - 1
