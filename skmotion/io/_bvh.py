@@ -2,11 +2,11 @@
 
 import dataclasses
 import io
-import itertools
 import re
 
 import numpy as np
 
+from skmotion.io._bvh_hierarchy import parse_hierarchy
 from skmotion.io._errors import MotionFileError
 from skmotion.io._motion import Motion
 from skmotion.io._text import (
@@ -18,170 +18,13 @@ from skmotion.io._text import (
     parse_number,
     read_text,
 )
-from skmotion.kinematics import CHANNEL_KINDS, Skeleton, forward_kinematics
+from skmotion.kinematics import Skeleton, forward_kinematics
 
 __all__ = ["detect_up_axis", "read_bvh"]
 
-_CHANNELS = {c.lower(): c for c in CHANNEL_KINDS}
 _UP_AXES = ("x", "y", "z", None)
-_WORD = re.compile(r"[{}]|[^\s{}]+", flags=re.ASCII)
 _DIGITS = re.compile(r"[0-9]+")
 _CHUNK_BYTES = 1 << 22  # the MOTION block is parsed in pieces of about 4 MB
-
-
-class _HeaderParser:
-    """Parser of the HIERARCHY block: iterative (a stack of open joints), one pass.
-
-    A joint's name is the rest of its ``ROOT``/``JOINT`` line, kept verbatim but for
-    the surrounding blanks and a trailing ``{`` (3ds Max writes ``JOINT Bip01 Neck``).
-    """
-
-    def __init__(self, path, text):
-        self.path = path
-        self.lines = text.split("\n")
-        self.words, self.line_of, self.line_start = [], [], {}
-        for number, line in enumerate(self.lines, start=1):
-            found = _WORD.findall(line)
-            if found:
-                self.line_start[number] = len(self.words)
-                self.words.extend(found)
-                self.line_of.extend([number] * len(found))
-        self.pos = 0
-        self.joints, self.parents, self.offsets, self.channels = [], [], [], []
-        self.names = set()
-
-    def error(self, message, line=None):
-        if line is None:
-            at = min(self.pos, len(self.words) - 1)
-            line = self.line_of[at] if self.words else 1
-        return MotionFileError(self.path, line, message)
-
-    def next(self, what):
-        if self.pos >= len(self.words):
-            raise self.error(f"file ends where {what} was expected")
-        self.pos += 1
-        return self.words[self.pos - 1], self.line_of[self.pos - 1]
-
-    def expect(self, keyword, context):
-        word, line = self.next(f"{keyword!r}")
-        if word.upper() != keyword.upper():
-            raise self.error(f"expected {keyword!r} {context}, found {word!r}", line)
-        return line
-
-    def offset(self, context):
-        values = []
-        for _ in range(3):
-            word, line = self.next(f"a number ({context})")
-            try:
-                value = float(word) if is_special(word) else parse_number(word)
-            except ValueError:
-                raise self.error(f"non-numeric value {word!r} in {context}", line) from None
-            if not np.isfinite(value):
-                raise self.error(f"non-finite value {word!r} in {context}", line)
-            values.append(value)
-        return values
-
-    def parse(self):
-        self.expect("HIERARCHY", "at the start of a BVH file")
-        self.expect("ROOT", "after HIERARCHY")
-        stack = [self.joint(parent=-1)]
-        while stack:
-            index, opened = stack[-1]
-            name = self.joints[index]
-            word, line = self.next(f"'}}' closing joint {name!r} (opened at line {opened})")
-            key = word.upper()
-            if word == "}":
-                stack.pop()
-            elif key == "JOINT":
-                stack.append(self.joint(index))
-            elif key == "END":
-                self.end_site(index, line)
-            else:
-                raise self.error(
-                    f"expected JOINT, End Site or '}}' in joint {name!r} (opened at line "
-                    f"{opened}), found {word!r}",
-                    line,
-                )
-        if self.pos < len(self.words):
-            word, line = self.words[self.pos], self.line_of[self.pos]
-            if word.upper() == "ROOT":
-                raise self.error(
-                    "a second ROOT: files with several hierarchies are not supported", line
-                )
-            raise self.error(f"unexpected {word!r} after the hierarchy (a '}}' too many?)", line)
-
-    def joint_name(self):
-        """The rest of the keyword's line; the words on it are consumed (but a final '{')."""
-        line = self.line_of[self.pos - 1]
-        text = self.lines[line - 1]
-        # The keyword is the k-th word of its line (nearly always the first): where does it end?
-        k = self.pos - 1 - self.line_start[line]
-        found = _WORD.finditer(text)
-        keyword_end = next(itertools.islice(found, k, None)).end()
-        rest = text[keyword_end:].strip()
-        end = self.pos
-        while end < len(self.words) and self.line_of[end] == line:
-            end += 1
-        if rest.endswith("{") and end > self.pos:
-            rest, end = rest[:-1].rstrip(), end - 1  # the brace opens the joint
-        self.pos = end
-        if not rest:
-            raise self.error("a joint without a name", line)
-        if "{" in rest or "}" in rest:
-            raise self.error(f"joint name {rest!r} contains a brace", line)
-        return rest, line
-
-    def joint(self, parent):
-        name, line = self.joint_name()
-        if name in self.names:
-            raise self.error(f"joint name {name!r} appears twice", line)
-        index = len(self.joints)
-        self.names.add(name)
-        self.joints.append(name)
-        self.parents.append(parent)
-        opened = self.expect("{", f"after joint {name!r}")
-        self.expect("OFFSET", f"in joint {name!r}")
-        self.offsets.append(self.offset(f"OFFSET of {name!r}"))
-        self.channels.append(self.channel_list(name))
-        return index, opened
-
-    def channel_list(self, name):
-        self.expect("CHANNELS", f"in joint {name!r}")
-        word, line = self.next("the channel count")
-        if not _DIGITS.fullmatch(word):
-            raise self.error(
-                f"channel count of joint {name!r} must be an integer, found {word!r}", line
-            )
-        channels = []
-        for _ in range(int(word)):
-            word, line = self.next(f"a channel name of joint {name!r}")
-            channel = _CHANNELS.get(word.lower())
-            if channel is None:
-                raise self.error(
-                    f"unknown channel {word!r} of joint {name!r} (expected one of "
-                    f"{list(CHANNEL_KINDS)})",
-                    line,
-                )
-            if channel in channels:
-                raise self.error(f"joint {name!r} lists channel {word!r} twice", line)
-            channels.append(channel)
-        return channels
-
-    def end_site(self, parent, line):
-        self.expect("Site", "after 'End'")
-        name = f"{self.joints[parent]}_end"
-        suffix = 2
-        while name in self.names:
-            name, suffix = f"{self.joints[parent]}_end{suffix}", suffix + 1
-        opened = self.expect("{", "after End Site")
-        self.expect("OFFSET", "in End Site")
-        offset = self.offset(f"OFFSET of the End Site of {self.joints[parent]!r}")
-        self.expect("}", f"closing the End Site opened at line {opened}")
-        self.names.add(name)
-        self.joints.append(name)
-        self.parents.append(parent)
-        self.offsets.append(offset)
-        self.channels.append([])
 
 
 def _frame_rate(path, line, text):
@@ -427,10 +270,11 @@ def read_bvh(path, *, up_axis=None):
     found = re.search(rb"^[ \t]*MOTION\b", data, flags=re.MULTILINE | re.IGNORECASE)
     if found is None:
         raise MotionFileError(path, None, "no MOTION block (not a BVH file, or truncated)")
-    parser = _HeaderParser(path, decode_text(data[: found.start()]))
-    parser.parse()
+    joints, parents, offsets, channel_lists = parse_hierarchy(
+        path, decode_text(data[: found.start()])
+    )
     try:
-        skeleton = Skeleton(parser.joints, parser.parents, parser.offsets, parser.channels)
+        skeleton = Skeleton(joints, parents, offsets, channel_lists)
     except ValueError as exc:
         raise MotionFileError(path, None, f"the hierarchy is not a valid skeleton: {exc}") from None
     start = found.start() + len(found.group()) - len(found.group().lstrip())
