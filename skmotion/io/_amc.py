@@ -6,7 +6,7 @@ import numpy as np
 
 from skmotion.io._errors import MotionFileError
 from skmotion.io._motion import Motion
-from skmotion.io._text import Tokens, parse_floats, read_text
+from skmotion.io._text import Tokens, is_special, parse_floats, read_text
 from skmotion.kinematics import Skeleton
 
 __all__ = ["read_amc"]
@@ -154,7 +154,9 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     misplaced = np.flatnonzero(named & ~lead)
     if misplaced.size:
         k = misplaced[0]
-        raise MotionFileError(path, int(tokens.lines[k]), f"non-numeric value {tokens.text(k)!r}")
+        word = tokens.text(k)
+        problem = "non-finite" if is_special(word) else "non-numeric"
+        raise MotionFileError(path, int(tokens.lines[k]), f"{problem} value {word!r}")
     name_tokens = np.flatnonzero(named)
     joints = _joint_ids(tokens, name_tokens, skeleton)
     if (joints < 0).any():

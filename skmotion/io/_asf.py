@@ -253,7 +253,9 @@ def _build(lines, units, root, bones, children):
         # A bone's joint sits at the end of its parent bone; the root's bones start at the root.
         offset = vectors.get(names[parent], np.zeros(3))
         vectors[name] = bone["length"] * direction / np.linalg.norm(direction)
-        if not np.isfinite(offset + vectors[name]).all():
+        with np.errstate(over="ignore"):
+            overflow = not np.isfinite(offset + vectors[name]).all()
+        if overflow:
             raise lines.error(
                 bone["line"], f"bone {name!r}: its length {bone['length']:g} overflows a float"
             )

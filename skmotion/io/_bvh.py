@@ -107,7 +107,7 @@ def _motion_block(path, data, start, n_channels):
             first_line,
             "expected 'MOTION', 'Frames: N' and 'Frame Time: T' lines (each alone on its line)",
         )
-    frames_text = header.group(1).decode("latin-1")
+    frames_text = decode_text(header.group(1))
     if not _DIGITS.fullmatch(frames_text):
         raise MotionFileError(
             path,
@@ -116,7 +116,7 @@ def _motion_block(path, data, start, n_channels):
         )
     n_frames = int(frames_text)
     frame_rate = _frame_rate(
-        path, data.count(b"\n", 0, header.start(2)) + 1, header.group(2).decode("latin-1")
+        path, data.count(b"\n", 0, header.start(2)) + 1, decode_text(header.group(2))
     )
     if n_channels == 0:
         raise MotionFileError(path, first_line, "the hierarchy has no channels")
