@@ -17,6 +17,7 @@ from skmotion.decomposition._svd_features import _N_VECTORS
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
 from skmotion.utils._clips import check_clips
+from skmotion.utils._labels import check_label_types
 from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, _fit_context
 
@@ -256,6 +257,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     def _check_labels(self, y, n, *, known=False):
         # Labels that must be among classes_ (known=True) are checked against
         # them instead: type_of_target costs milliseconds, a clip insertion less.
+        check_label_types(y)
         if not known:
             check_classification_targets(y)
         y = column_or_1d(y, warn=True)

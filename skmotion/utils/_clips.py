@@ -134,6 +134,13 @@ def _collection_from_dataframe(X, input_name):
     if len(X) == 0:
         raise ValueError(f"{input_name} is an empty collection: it holds no clips.")
     codes, labels = pd.factorize(index.get_level_values(0), sort=False)
+    for level, what in ((codes, "clip"), (index.codes[1], "frame")):
+        if (level < 0).any():  # pandas codes a missing label (NaN, None) as -1
+            row = int(np.flatnonzero(level < 0)[0])
+            raise ValueError(
+                f"{input_name}: row {row} of the DataFrame has a missing {what} label (NaN) in "
+                "its (clip, frame) index; every row needs a clip and a frame label."
+            )
     starts = np.flatnonzero(np.r_[True, codes[1:] != codes[:-1]])
     if len(starts) != len(labels):
         repeated = labels[np.bincount(codes[starts]).argmax()]
