@@ -11,8 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skmotion.datasets import make_motions
-from skmotion.io import Motion, MotionFileError, read_bvh, write_bvh
-from skmotion.io import _bvh_write
+from skmotion.io import Motion, MotionFileError, _bvh_write, read_bvh, write_bvh
 from skmotion.io._bvh_hierarchy import parse_hierarchy
 from skmotion.kinematics import Skeleton
 

@@ -6,8 +6,7 @@ import pandas as pd
 import pytest
 from scipy.signal import butter, freqz_sos
 
-from skmotion.preprocessing import LowPassFilter, ResampleClips, lowpass_filter
-from skmotion.preprocessing import _resample
+from skmotion.preprocessing import LowPassFilter, ResampleClips, _resample, lowpass_filter
 from skmotion.utils import check_clips
 from tests.bad_input.estimators import ENTRIES, fit
 
