@@ -78,7 +78,9 @@ def _attempt(url, target, timeout, check):
                 check(temporary)
             except MotionFileError as exc:
                 where = "" if exc.line is None else f" (line {exc.line})"
-                raise _Retry(f"the download does not read as a motion file{where}: {exc.message}")
+                raise _Retry(
+                    f"the download does not read as a motion file{where}: {exc.message}"
+                ) from None
         except BaseException:
             os.unlink(temporary)
             raise

@@ -127,11 +127,13 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     ...     root femur
     ...   end
     ... '''
-    >>> amc = ":FULLY-SPECIFIED\\n:DEGREES\\n1\\nroot 0 20 0 0 0 0\\nfemur 0\\n2\\nroot 0 20 0 0 0 0\\nfemur 90\\n"
+    >>> amc = ":FULLY-SPECIFIED\\n:DEGREES\\n1\\nroot 0 20 0 0 0 0\\nfemur 0\\n"
+    >>> amc += "2\\nroot 0 20 0 0 0 0\\nfemur 90\\n"
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     _ = open(os.path.join(folder, "a.asf"), "w").write(asf)
     ...     _ = open(os.path.join(folder, "a.amc"), "w").write(amc)
-    ...     motion = read_amc(os.path.join(folder, "a.amc"), read_asf(os.path.join(folder, "a.asf")))
+    ...     skeleton = read_asf(os.path.join(folder, "a.asf"))
+    ...     motion = read_amc(os.path.join(folder, "a.amc"), skeleton)
     >>> motion.channels[:, 6].tolist() == [0.0, np.pi / 2]
     True
     >>> motion.forward_kinematics().positions[:, 2].round(6) + 0.0  # the femur's tip

@@ -167,7 +167,8 @@ def _check_values(values, names):
     if bad.any():
         frame, column = np.argwhere(bad)[0]
         raise ValueError(
-            f"Frame {frame}, channel {names[column]!r} is {float(values[frame, column])!r} when written "
+            f"Frame {frame}, channel {names[column]!r} is {float(values[frame, column])!r} "
+            "when written "
             f"({int(bad.sum())} non-finite values): BVH files hold finite numbers only."
         )
 

@@ -24,7 +24,7 @@ def _motion(random_state=0):
     return Motion(data.skeletons[0], data.clips[0], frame_rate=data.frame_rate)
 
 
-# -- atomic writes ------------------------------------------------------------------------------------
+# -- atomic writes --
 
 
 def test_an_interrupted_write_leaves_the_old_file(tmp_path, monkeypatch):
@@ -59,7 +59,7 @@ def test_a_new_file_gets_ordinary_permissions_and_an_old_one_keeps_its_own(tmp_p
     assert path.stat().st_mode & 0o777 == 0o640
 
 
-# -- validation before writing ------------------------------------------------------------------------
+# -- validation before writing --
 
 
 def _leg(names=("hip", "knee", "foot"), channels=None):
@@ -128,7 +128,7 @@ def test_names_with_spaces_and_channel_less_leaves_read_back_verbatim(tmp_path):
     np.testing.assert_allclose(back.channels, channels, rtol=1e-13, atol=1e-13)
 
 
-# -- property: random skeletons written then read back equal --------------------------------------------
+# -- property: random skeletons written then read back equal --
 
 
 @st.composite
@@ -203,7 +203,7 @@ def test_random_skeletons_read_back_equal(tmp_path_factory, skeleton, n_frames, 
     assert back.frame_rate == 60.0
 
 
-# -- the hierarchy parser ------------------------------------------------------------------------------
+# -- the hierarchy parser --
 
 
 def _chain(depth):
@@ -274,7 +274,8 @@ def test_sibling_joints_parse_in_linear_time():
 )
 def test_a_joint_name_is_the_rest_of_its_line(line, name):
     text = (
-        "HIERARCHY\nROOT Bip01 Pelvis\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n"
+        "HIERARCHY\nROOT Bip01 Pelvis\n{\n OFFSET 0 0 0\n"
+        " CHANNELS 3 Zrotation Xrotation Yrotation\n"
         f" {line}\n"
         + (" {\n" if not line.rstrip().endswith("{") else "")
         + "  OFFSET 0 1 0\n  CHANNELS 1 Xrotation\n }\n}\n"
@@ -294,7 +295,8 @@ def test_a_joint_name_is_the_rest_of_its_line(line, name):
 )
 def test_bad_joint_names_are_named_with_their_line(line, message):
     text = (
-        "HIERARCHY\nROOT Bip01 Pelvis\n{\n OFFSET 0 0 0\n CHANNELS 3 Zrotation Xrotation Yrotation\n"
+        "HIERARCHY\nROOT Bip01 Pelvis\n{\n OFFSET 0 0 0\n"
+        " CHANNELS 3 Zrotation Xrotation Yrotation\n"
         f" {line}\n {{\n  OFFSET 0 1 0\n  CHANNELS 1 Xrotation\n }}\n}}\n"
     )
     with pytest.raises(MotionFileError, match=message) as info:

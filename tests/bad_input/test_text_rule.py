@@ -121,7 +121,7 @@ def test_utf16_is_refused_with_a_clear_message(tmp_path, kind):
         _read(kind, tmp_path, data)
 
 
-# -- errors of item 6: each names the file and its line ---------------------------------------------
+# -- errors of item 6: each names the file and its line --
 
 
 def _bvh(tmp_path, text):
