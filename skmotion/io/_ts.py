@@ -23,7 +23,7 @@ def _parse_header(path, lines):
             continue
         if not line.startswith("@"):
             raise MotionFileError(path, number, "data before the @data tag")
-        key, _, value = line[1:].partition(" ")
+        key, _, value = line[1:].replace("\t", " ").partition(" ")  # tabs separate too
         key = key.lower()
         if key == "data":
             return tags, number
@@ -33,7 +33,7 @@ def _parse_header(path, lines):
                 raise MotionFileError(path, number, f"@{key} must be true or false, got {value!r}")
             tags[key] = value.lower() == "true"
         elif key == "classlabel":
-            flag, _, labels = value.partition(" ")
+            flag, _, labels = value.replace("\t", " ").partition(" ")
             if flag.lower() not in ("true", "false"):
                 raise MotionFileError(
                     path, number, f"@classLabel must start with true or false, got {flag!r}"

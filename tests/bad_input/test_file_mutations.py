@@ -118,7 +118,8 @@ def check_asf(skeleton, text):
 
 def check_ts(result, text):
     clips, labels = result
-    data = [line.strip(" \t\r") for line in text.split("@data", 1)[1].split("\n")]
+    body = re.split(r"^[ \t]*@data", text, maxsplit=1, flags=re.I | re.M)[1]  # tags: any case
+    data = [line.strip(" \t\r") for line in body.split("\n")]
     data = [line for line in data if line and not line.startswith("#")]
     assert len(clips) == len(data)
     for clip, line in zip(clips, data):

@@ -202,3 +202,13 @@ def test_asf_length_that_overflows_names_the_bone(tmp_path):
     ) as info:
         read_asf(path)
     assert info.value.line == line
+
+
+def test_ts_header_tags_separated_by_tabs(tmp_path):
+    """Tabs separate tokens in every reader, .ts header tags included."""
+    base = files.written_ts()
+    original, _ = _read("ts", tmp_path, base, "original")
+    tabbed = re.sub(rb"(?m)^(@\w+) ", rb"\1\t", base).replace(b"true walk", b"true\twalk")
+    assert tabbed != base
+    changed, _ = _read("ts", tmp_path, tabbed)
+    assert _same("ts", original, changed)
