@@ -206,7 +206,7 @@ def _check_feature_names(X, estimator, reset, input_name):
 
 
 def _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name):
-    """The clips of a collection as C-contiguous float arrays, checked one by one; and their channel count."""
+    """The clips as C-contiguous float arrays, checked one by one; and their channel count."""
     clips = []
     n_channels = None
     for i, clip in enumerate(raw):
@@ -318,7 +318,7 @@ def check_clips(
     >>> check_clips([np.zeros((5, 3)), np.ones((8, 2))])
     Traceback (most recent call last):
     ...
-    ValueError: X: clip 1 has 2 channels, but clip 0 has 3; all clips of a collection share their channels.
+    ValueError: X: clip 1 has 2 channels, but clip 0 has 3; all clips of a collection ...
     """
     dtypes = _normalise_dtypes(dtype)
     name = _estimator_name(estimator)
