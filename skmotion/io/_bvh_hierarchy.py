@@ -130,10 +130,13 @@ class _Parser:
         while first > 0 and line_of[first - 1] == line:
             first -= 1
         text = self.text_lines[line - 1]
-        found = _WORD.finditer(text)
-        for _ in range(keyword - first):
-            next(found)
-        rest = text[next(found).end() :].strip(" \t")
+        if first == keyword:  # the usual layout: the keyword opens its line
+            rest = text.lstrip(" \t")[len(self.words[keyword]) :].strip(" \t")
+        else:
+            found = _WORD.finditer(text)
+            for _ in range(keyword - first):
+                next(found)
+            rest = text[next(found).end() :].strip(" \t")
         end = self.pos
         while end < len(line_of) and line_of[end] == line:
             end += 1
