@@ -51,12 +51,12 @@ def _content_length(response):
     return int(value) if value is not None and value.strip().isdigit() else None
 
 
-def _looks_like_html(path, response):
-    headers = getattr(response, "headers", None)
-    kind = (headers.get("Content-Type") or "") if headers is not None else ""
+def _looks_like_html(path):
+    """An error page served with status 200 (judged by content: some servers label
+    plain-text motion files ``text/html``, so the Content-Type header is not used)."""
     with open(path, "rb") as fh:
         head = fh.read(1024).lstrip().lower()
-    return "html" in kind.lower() or head.startswith(_HTML_STARTS)
+    return head.startswith(_HTML_STARTS)
 
 
 def _attempt(url, target, timeout, check):
@@ -72,7 +72,7 @@ def _attempt(url, target, timeout, check):
             size = os.path.getsize(temporary)
             if expected is not None and size != expected:
                 raise _Retry(f"received {size} of {expected} bytes")
-            if _looks_like_html(temporary, response):
+            if _looks_like_html(temporary):
                 raise _Retry("the server sent an HTML page, not a motion file")
             try:
                 check(temporary)

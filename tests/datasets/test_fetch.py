@@ -33,7 +33,8 @@ class Handler(http.server.BaseHTTPRequestHandler):
         if how == "html":  # an error page with status 200, as some proxies send
             body = HTML
         self.send_response(200)
-        self.send_header("Content-Type", "text/html" if how == "html" else "text/plain")
+        html = how in ("html", "mislabelled")
+        self.send_header("Content-Type", "text/html" if html else "text/plain")
         self.send_header("Content-Length", str(len(body)))
         self.end_headers()
         if how == "cut":  # the connection drops halfway: IncompleteRead for the client
@@ -116,6 +117,13 @@ def test_a_server_recovering_after_failures(server, tmp_path):
     data = fetch_cmu_mocap(5, trials=[1], data_home=tmp_path, verbose=1)
     assert server.requests == ["05.asf"] * 3 + ["05_01.amc"] * 3
     np.testing.assert_array_equal(data.clips[0], _expected(server, tmp_path, "05_01.amc"))
+
+
+def test_a_motion_file_labelled_text_html_is_judged_by_its_content(server, tmp_path):
+    server.plan["05.asf"] = ["mislabelled"]
+    data = fetch_cmu_mocap(5, trials=[1], data_home=tmp_path)
+    assert server.requests == ["05.asf", "05_01.amc"]
+    assert data.skeletons[0] == _expected(server, tmp_path, "05.asf")
 
 
 def test_a_permanent_http_error_is_not_retried(server, tmp_path):
