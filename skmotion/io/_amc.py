@@ -21,12 +21,12 @@ def _header(path, data):
         raise MotionFileError(path, None, "no frame number: the file holds no frames")
     unit = None
     for number, line in enumerate(data[: found.start()].decode("latin-1").split("\n"), start=1):
-        word = line.strip()
+        word = line.strip(" \t")
         if not word or word.startswith("#"):
             continue
         if not word.startswith(":"):
             raise MotionFileError(
-                path, number, f"bone data before the first frame number: {word.split()[0]!r}"
+                path, number, f"bone data before the first frame number: {word.split(' ')[0]!r}"
             )
         if word.upper() in (":DEGREES", ":RADIANS"):
             unit = "deg" if word.upper() == ":DEGREES" else "rad"

@@ -18,7 +18,7 @@ def _parse_header(path, lines):
     """Header tags up to ``@data``; returns (tags, index of the first data line)."""
     tags = {}
     for number, raw in enumerate(lines, start=1):
-        line = raw.strip()
+        line = raw.strip(" \t")  # the text rule: blanks are spaces and tabs only
         if not line or line.startswith("#"):
             continue
         if not line.startswith("@"):
@@ -27,7 +27,7 @@ def _parse_header(path, lines):
         key = key.lower()
         if key == "data":
             return tags, number
-        value = value.strip()
+        value = value.strip(" \t")
         if key in _BOOLEAN_TAGS:
             if value.lower() not in ("true", "false"):
                 raise MotionFileError(path, number, f"@{key} must be true or false, got {value!r}")
@@ -38,7 +38,9 @@ def _parse_header(path, lines):
                 raise MotionFileError(
                     path, number, f"@classLabel must start with true or false, got {flag!r}"
                 )
-            tags["classlabel"] = labels.split() if flag.lower() == "true" else None
+            tags["classlabel"] = (
+                [w for w in labels.split(" ") if w] if flag.lower() == "true" else None
+            )
         elif key in ("dimensions", "serieslength"):
             if not _DIGITS.fullmatch(value):
                 raise MotionFileError(path, number, f"@{key} must be an integer, got {value!r}")
@@ -49,7 +51,7 @@ def _parse_header(path, lines):
 
 
 def _parse_dimension(path, number, index, text):
-    values = [v.strip() for v in text.split(",")]
+    values = [v.strip(" \t") for v in text.split(",")]
     column = None
     # Only digits, signs, dots, exponents and '?': float() alone would take '1_0' or 'inf'.
     if number_bytes_only(text.replace(",", " ").replace("?", " ").encode("utf-8")):
@@ -132,12 +134,12 @@ def read_ts(path):
     n_dims = tags.get("dimensions", 1 if tags.get("univariate") else None)
     clips, labels = [], []
     for number in range(data_line + 1, len(lines) + 1):
-        line = lines[number - 1].strip()
+        line = lines[number - 1].strip(" \t")
         if not line or line.startswith("#"):
             continue
         fields = line.split(":")
         if class_labels is not None:
-            label = fields.pop().strip()
+            label = fields.pop().strip(" \t")
             if label not in class_labels:
                 raise MotionFileError(
                     path,

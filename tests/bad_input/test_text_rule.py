@@ -60,6 +60,7 @@ EDITS = {
     "underscore 9_0 style": (lambda v: v[:1] + b"_0" + v[1:], "non-numeric value"),
     "Arabic-Indic digit": (lambda v: "\u0661".encode() + v, "non-numeric value"),
     "no-break space as a separator": (lambda v: v + "\u00a0".encode() + b"1", "non-numeric"),
+    "no-break space before a number": (lambda v: "\u00a0".encode() + v, "non-numeric"),
     "infinity spelled out": (lambda v: b"infinity", "non-finite value"),
     "overflow 1e400": (lambda v: b"1e400", "non-finite value"),
 }
