@@ -1,20 +1,39 @@
-"""Downloading CMU motion capture subjects into a local cache."""
+"""Downloading CMU motion capture subjects into a local cache.
 
+A file enters the cache only whole and readable: it is downloaded to a unique
+temporary name in the cache folder, its size is checked against the server's
+``Content-Length``, it is refused when it is an HTML page, and it is parsed with
+:func:`read_asf` / :func:`read_amc` before :func:`os.replace` gives it its name.
+Transient failures (a cut connection, a timeout, a 5xx answer, a truncated or
+unreadable body) are retried with exponential back-off, then reported as one
+``ConnectionError`` naming the URL, the last reason and the cache folder.
+"""
+
+import http.client
 import os
 import shutil
+import tempfile
+import time
 import urllib.error
 import urllib.request
+from numbers import Integral
 
 import numpy as np
 
 from skmotion.datasets._home import get_data_home
 from skmotion.datasets._motion_files import _as_index, load_cmu_asfamc
+from skmotion.io import MotionFileError, read_amc, read_asf
+from skmotion.utils import progress, say
 
 __all__ = ["fetch_cmu_mocap"]
 
-CMU_URL = "http://mocap.cs.cmu.edu/subjects"
+CMU_URL = "https://mocap.cs.cmu.edu/subjects"
 _COMPLETE = ".complete"  # written once every trial of a probed subject is in the cache
 _MAX_TRIALS = 200
+_ATTEMPTS = 3  # tries per file
+_BACKOFF = 0.5  # seconds before the second try; doubled before each further one
+_TRANSIENT_HTTP = frozenset({408, 425, 429, 500, 502, 503, 504})
+_HTML_STARTS = (b"<!doctype", b"<html", b"<head", b"<body", b"<?xml")
 
 
 def _urlopen(url, timeout):
@@ -22,49 +41,157 @@ def _urlopen(url, timeout):
     return urllib.request.urlopen(url, timeout=timeout)
 
 
-def _download(url, target, timeout):
-    """Fetch ``url`` into ``target`` atomically; False when the server says 404."""
-    partial = target.with_name(target.name + ".part")
-    try:
-        with _urlopen(url, timeout) as response, open(partial, "wb") as fh:
-            shutil.copyfileobj(response, fh)
-    except urllib.error.HTTPError as exc:
-        partial.unlink(missing_ok=True)
-        if exc.code == 404:
-            return False
-        raise ConnectionError(f"Could not download {url}: HTTP {exc.code} {exc.reason}.") from None
-    except (urllib.error.URLError, OSError) as exc:
-        partial.unlink(missing_ok=True)
-        reason = getattr(exc, "reason", exc)
-        raise ConnectionError(
-            f"Could not download {url} ({reason}): skmotion needs the network to fetch CMU data the first "
-            f"time. Offline, place the files in {target.parent} yourself (NN.asf and NN_TT.amc)."
-        ) from None
-    os.replace(partial, target)
-    return True
+class _Retry(Exception):
+    """A transient failure of one attempt: the reason is kept for the final message."""
+
+
+def _content_length(response):
+    headers = getattr(response, "headers", None)
+    value = headers.get("Content-Length") if headers is not None else None
+    return int(value) if value is not None and value.strip().isdigit() else None
+
+
+def _looks_like_html(path):
+    """An error page served with status 200 (judged by content: some servers label
+    plain-text motion files ``text/html``, so the Content-Type header is not used)."""
+    with open(path, "rb") as fh:
+        head = fh.read(1024).lstrip().lower()
+    return head.startswith(_HTML_STARTS)
+
+
+def _attempt(url, target, timeout, check):
+    """Download once into a unique temporary file in the cache folder; return its path."""
+    with _urlopen(url, timeout) as response:
+        expected = _content_length(response)
+        fd, temporary = tempfile.mkstemp(
+            dir=target.parent, prefix=f".{target.name}.", suffix=".part"
+        )
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                shutil.copyfileobj(response, fh)
+            size = os.path.getsize(temporary)
+            if expected is not None and size != expected:
+                raise _Retry(f"received {size} of {expected} bytes")
+            if _looks_like_html(temporary):
+                raise _Retry("the server sent an HTML page, not a motion file")
+            try:
+                check(temporary)
+            except MotionFileError as exc:
+                where = "" if exc.line is None else f" (line {exc.line})"
+                raise _Retry(
+                    f"the download does not read as a motion file{where}: {exc.message}"
+                ) from None
+        except BaseException:
+            os.unlink(temporary)
+            raise
+    return temporary
+
+
+def _download(url, target, timeout, check, verbose=0):
+    """Fetch ``url`` into ``target`` whole and checked; False when the server says 404."""
+    reason = None
+    for attempt in range(_ATTEMPTS):
+        if attempt:
+            time.sleep(_BACKOFF * 2 ** (attempt - 1))
+        try:
+            temporary = _attempt(url, target, timeout, check)
+        except urllib.error.HTTPError as exc:
+            if exc.code == 404:
+                return False
+            reason = f"HTTP {exc.code} {exc.reason}"
+            if exc.code not in _TRANSIENT_HTTP:
+                raise ConnectionError(f"Could not download {url}: {reason}.") from None
+        except _Retry as exc:
+            reason = str(exc)
+        except (urllib.error.URLError, http.client.HTTPException, OSError) as exc:
+            # URLError (no network, DNS), IncompleteRead, RemoteDisconnected, timeouts, resets.
+            reason = str(getattr(exc, "reason", "") or exc) or type(exc).__name__
+        else:
+            os.replace(temporary, target)
+            say(verbose, f"downloaded {url}")
+            return True
+        say(verbose, f"{url}: attempt {attempt + 1} of {_ATTEMPTS} failed ({reason})")
+    raise ConnectionError(
+        f"Could not download {url} ({reason}) after {_ATTEMPTS} attempts. skmotion needs the "
+        f"network to fetch CMU data the first time; offline, place the files in {target.parent} "
+        "yourself (NN.asf and NN_TT.amc)."
+    )
+
+
+def _whole_numbers(values, what):
+    """A list of positive ints from an int or a list of ints (NumPy ints too; not bool, not 2.7)."""
+    items = list(values) if isinstance(values, (list, tuple, np.ndarray, range)) else [values]
+    out = []
+    for value in items:
+        if isinstance(value, (bool, np.bool_)) or not isinstance(value, Integral):
+            raise TypeError(
+                f"{what} must be whole numbers (int), got {value!r} of type {type(value).__name__}."
+            )
+        if value < 1:
+            raise ValueError(f"{what} must be positive, got {int(value)}.")
+        out.append(int(value))
+    if not out:
+        raise ValueError(f"{what} is empty: give at least one number.")
+    return out
 
 
 def _subject_trials(subject, trials, index):
     if trials is not None:
-        return sorted({int(t) for t in np.atleast_1d(trials)})
+        return sorted(set(trials))
     if index is not None:
         return sorted(index.loc[index["subject"] == subject, "trial"].astype(int))
     return None  # probe 01, 02, ... until the server has no more
 
 
-def fetch_cmu_mocap(subjects, *, trials=None, data_home=None, index=None, timeout=30.0):
+def _verify(folder, skeleton_file, verbose):
+    """Re-read every cached file of a subject folder; remove those that do not read."""
+    removed = []
+    stale = time.time() - 3600  # a '.part' file this old belongs to no running download
+    for part in folder.glob(".*.part"):
+        if part.stat().st_mtime < stale:
+            part.unlink(missing_ok=True)
+    skeleton = None
+    if skeleton_file.is_file():
+        try:
+            skeleton = read_asf(skeleton_file)
+        except MotionFileError as exc:
+            say(verbose, f"removing {skeleton_file}: {exc}")
+            removed.append(skeleton_file)
+    for amc in sorted(folder.glob("*.amc")):
+        try:
+            if skeleton is None:
+                raise MotionFileError(amc, None, "its skeleton file is missing or broken")
+            read_amc(amc, skeleton)
+        except MotionFileError as exc:
+            say(verbose, f"removing {amc}: {exc}")
+            removed.append(amc)
+    for path in removed:
+        path.unlink(missing_ok=True)
+    if removed:
+        (folder / _COMPLETE).unlink(missing_ok=True)
+    return removed
+
+
+def fetch_cmu_mocap(
+    subjects, *, trials=None, data_home=None, index=None, timeout=30.0, verify=False, verbose=0
+):
     """Download CMU subjects' ASF/AMC files into a cache and load them.
 
-    Files come from ``http://mocap.cs.cmu.edu/subjects/NN/NN.asf`` and
+    Files come from ``https://mocap.cs.cmu.edu/subjects/NN/NN.asf`` and
     ``.../NN/NN_TT.amc`` into ``<data_home>/cmu-asfamc/NN/``, the layout
-    :func:`load_cmu_asfamc` reads. Files already in the cache are never
-    downloaded again; a subject whose trials were all fetched once (or whose
-    requested trials are cached) needs no network at all.
+    :func:`load_cmu_asfamc` reads. A file enters the cache only whole and
+    readable: it is downloaded to a unique temporary name, checked against the
+    server's ``Content-Length``, refused when it is an HTML page, and read with
+    :func:`~skmotion.io.read_asf` / :func:`~skmotion.io.read_amc` before an
+    atomic rename gives it its name (concurrent fetches of one file are safe).
+    Transient failures are retried with back-off. Files already in the cache
+    are never downloaded again; a subject whose trials were all fetched once
+    (or whose requested trials are cached) needs no network at all.
 
     Parameters
     ----------
     subjects : int or list of int
-        CMU subject numbers.
+        CMU subject numbers (NumPy integers too; not floats or bools).
     trials : int or list of int, default=None
         Trial numbers to fetch for every subject. By default the trials the
         ``index`` lists, or, without an index, trials 1, 2, ... until the
@@ -75,6 +202,12 @@ def fetch_cmu_mocap(subjects, *, trials=None, data_home=None, index=None, timeou
         The CMU index CSV, for the trial list, descriptions and frame rates.
     timeout : float, default=30.0
         Seconds to wait for the server.
+    verify : bool, default=False
+        Re-read every cached file of the requested subjects first; files that
+        do not read (cut, or cached by an older version) are removed and
+        downloaded again.
+    verbose : int, default=0
+        1 or more reports each subject, download and retry on standard error.
 
     Returns
     -------
@@ -84,8 +217,12 @@ def fetch_cmu_mocap(subjects, *, trials=None, data_home=None, index=None, timeou
     Raises
     ------
     ConnectionError
-        When a file is not cached and cannot be downloaded (offline); the
-        message names the file and the cache folder.
+        When a file is not cached and cannot be downloaded after the retries;
+        the message names the URL, the last reason and the cache folder.
+    ValueError
+        When CMU has no such subject or trial (the server answers 404).
+    TypeError
+        When a subject or trial number is not a whole number (``2.7``, ``True``).
 
     Examples
     --------
@@ -94,43 +231,58 @@ def fetch_cmu_mocap(subjects, *, trials=None, data_home=None, index=None, timeou
     >>> data.trials.tolist()  # doctest: +SKIP
     ['02_01', '02_03']
     """
+    subjects = _whole_numbers(subjects, "subjects")
+    trials = None if trials is None else _whole_numbers(trials, "trials")
     index = _as_index(index)
-    subjects = [int(s) for s in np.atleast_1d(subjects)]
     root = get_data_home(data_home) / "cmu-asfamc"
-    for subject in subjects:
-        name = f"{subject:02d}"
-        folder = root / name
-        folder.mkdir(parents=True, exist_ok=True)
-        asf = folder / f"{name}.asf"
-        if not asf.is_file() and not _download(f"{CMU_URL}/{name}/{name}.asf", asf, timeout):
-            raise ValueError(
-                f"CMU has no subject {subject} ({CMU_URL}/{name}/{name}.asf not found)."
-            )
-        wanted = _subject_trials(subject, trials, index)
-        if wanted is None:
-            if (folder / _COMPLETE).is_file():
-                continue
-            for trial in range(1, _MAX_TRIALS + 1):
-                amc = folder / f"{name}_{trial:02d}.amc"
-                if not amc.is_file() and not _download(
-                    f"{CMU_URL}/{name}/{amc.name}", amc, timeout
-                ):
-                    break
-            (folder / _COMPLETE).write_text("every trial of this subject is cached\n")
-            continue
-        for trial in wanted:
-            amc = folder / f"{name}_{trial:02d}.amc"
-            if not amc.is_file() and not _download(f"{CMU_URL}/{name}/{amc.name}", amc, timeout):
-                raise ValueError(
-                    f"CMU has no trial {name}_{trial:02d} ({CMU_URL}/{name}/{amc.name} not found)."
-                )
+    for subject in progress(subjects, verbose=verbose, desc="CMU subjects"):
+        _fetch_subject(root, subject, trials, index, timeout, verify, verbose)
     data = load_cmu_asfamc(root, index, subjects=subjects)
     if trials is not None:
-        keep = np.isin(
-            [int(t.split("_")[1]) for t in data.trials], np.atleast_1d(trials).astype(int)
-        )
+        keep = np.isin([int(t.split("_")[1]) for t in data.trials], trials)
         data = _select(data, np.flatnonzero(keep))
     return data
+
+
+def _fetch_subject(root, subject, trials, index, timeout, verify, verbose):
+    name = f"{subject:02d}"
+    folder = root / name
+    folder.mkdir(parents=True, exist_ok=True)
+    asf = folder / f"{name}.asf"
+    if verify:
+        _verify(folder, asf, verbose)
+    if not asf.is_file() and not _download(
+        f"{CMU_URL}/{name}/{name}.asf", asf, timeout, read_asf, verbose
+    ):
+        raise ValueError(f"CMU has no subject {subject} ({CMU_URL}/{name}/{name}.asf not found).")
+    try:
+        skeleton = read_asf(asf)
+    except MotionFileError as exc:
+        raise MotionFileError(
+            exc.path, exc.line, f"{exc.message} (fetch_cmu_mocap(..., verify=True) replaces it)"
+        ) from None
+
+    def fetch(amc):
+        if amc.is_file():
+            return True
+        url = f"{CMU_URL}/{name}/{amc.name}"
+        return _download(url, amc, timeout, lambda path: read_amc(path, skeleton), verbose)
+
+    wanted = _subject_trials(subject, trials, index)
+    if wanted is None:
+        if (folder / _COMPLETE).is_file():
+            return
+        trial = 1
+        while trial <= _MAX_TRIALS and fetch(folder / f"{name}_{trial:02d}.amc"):
+            trial += 1
+        (folder / _COMPLETE).write_text("every trial of this subject is cached\n")
+        return
+    for trial in wanted:
+        if not fetch(folder / f"{name}_{trial:02d}.amc"):
+            raise ValueError(
+                f"CMU has no trial {name}_{trial:02d} ({CMU_URL}/{name}/{name}_{trial:02d}.amc "
+                "not found)."
+            )
 
 
 def _select(data, rows):

@@ -6,7 +6,7 @@ import numpy as np
 
 from skmotion.io._errors import MotionFileError
 from skmotion.io._motion import Motion
-from skmotion.io._text import Tokens, parse_floats, read_bytes
+from skmotion.io._text import Tokens, is_special, parse_floats, read_text
 from skmotion.kinematics import Skeleton
 
 __all__ = ["read_amc"]
@@ -20,13 +20,13 @@ def _header(path, data):
     if found is None:
         raise MotionFileError(path, None, "no frame number: the file holds no frames")
     unit = None
-    for number, line in enumerate(data[: found.start()].decode("latin-1").splitlines(), start=1):
-        word = line.strip()
+    for number, line in enumerate(data[: found.start()].decode("latin-1").split("\n"), start=1):
+        word = line.strip(" \t")
         if not word or word.startswith("#"):
             continue
         if not word.startswith(":"):
             raise MotionFileError(
-                path, number, f"bone data before the first frame number: {word.split()[0]!r}"
+                path, number, f"bone data before the first frame number: {word.split(' ')[0]!r}"
             )
         if word.upper() in (":DEGREES", ":RADIANS"):
             unit = "deg" if word.upper() == ":DEGREES" else "rad"
@@ -127,11 +127,13 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     ...     root femur
     ...   end
     ... '''
-    >>> amc = ":FULLY-SPECIFIED\\n:DEGREES\\n1\\nroot 0 20 0 0 0 0\\nfemur 0\\n2\\nroot 0 20 0 0 0 0\\nfemur 90\\n"
+    >>> amc = ":FULLY-SPECIFIED\\n:DEGREES\\n1\\nroot 0 20 0 0 0 0\\nfemur 0\\n"
+    >>> amc += "2\\nroot 0 20 0 0 0 0\\nfemur 90\\n"
     >>> with tempfile.TemporaryDirectory() as folder:
     ...     _ = open(os.path.join(folder, "a.asf"), "w").write(asf)
     ...     _ = open(os.path.join(folder, "a.amc"), "w").write(amc)
-    ...     motion = read_amc(os.path.join(folder, "a.amc"), read_asf(os.path.join(folder, "a.asf")))
+    ...     skeleton = read_asf(os.path.join(folder, "a.asf"))
+    ...     motion = read_amc(os.path.join(folder, "a.amc"), skeleton)
     >>> motion.channels[:, 6].tolist() == [0.0, np.pi / 2]
     True
     >>> motion.forward_kinematics().positions[:, 2].round(6) + 0.0  # the femur's tip
@@ -142,7 +144,7 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
         raise TypeError(
             f"skeleton must be a Skeleton (from read_asf), got {type(skeleton).__name__}."
         )
-    data = read_bytes(path)
+    data = read_text(path)
     unit, start, first_line = _header(path, data)
     tokens = Tokens(data[start:], first_line=first_line)
     buffer = np.frombuffer(tokens.data, dtype=np.uint8)
@@ -154,7 +156,9 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     misplaced = np.flatnonzero(named & ~lead)
     if misplaced.size:
         k = misplaced[0]
-        raise MotionFileError(path, int(tokens.lines[k]), f"non-numeric value {tokens.text(k)!r}")
+        word = tokens.text(k)
+        problem = "non-finite" if is_special(word) else "non-numeric"
+        raise MotionFileError(path, int(tokens.lines[k]), f"{problem} value {word!r}")
     name_tokens = np.flatnonzero(named)
     joints = _joint_ids(tokens, name_tokens, skeleton)
     if (joints < 0).any():
@@ -182,7 +186,8 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
         raise MotionFileError(
             path,
             int(tokens.lines[k]),
-            f"bone {skeleton.joints[j]!r} has {per_line[~is_frame][bad[0]] - 1} values, but its dof has {counts[j]}",
+            f"bone {skeleton.joints[j]!r} has {per_line[~is_frame][bad[0]] - 1} values, "
+            f"but its dof has {counts[j]}",
         )
 
     # Frame numbers, and which frame each bone line belongs to.
@@ -190,13 +195,18 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     value_index = np.cumsum(~named) - 1  # position of each numeric token in ``values``
     frame_numbers = values[value_index[lead_tokens[is_frame]]]
     frame_lines = tokens.lines[lead_tokens[is_frame]]
+    if len(frame_numbers) and not (frame_numbers[0] >= 0 and frame_numbers[0] % 1 == 0):
+        raise MotionFileError(
+            path, int(frame_lines[0]), f"frame number {frame_numbers[0]:g} is not a whole number"
+        )
     steps = np.diff(frame_numbers)
     if (steps != 1).any():
         k = int(np.flatnonzero(steps != 1)[0]) + 1
         raise MotionFileError(
             path,
             int(frame_lines[k]),
-            f"frame number {frame_numbers[k]:g} follows {frame_numbers[k - 1]:g}; frames must count up by one",
+            f"frame number {frame_numbers[k]:g} follows {frame_numbers[k - 1]:g}; "
+            "frames must count up by one",
         )
     n_frames = len(frame_numbers)
     frame_of_line = np.cumsum(is_frame) - 1

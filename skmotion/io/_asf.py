@@ -3,7 +3,7 @@
 import numpy as np
 
 from skmotion.io._errors import MotionFileError
-from skmotion.io._text import read_bytes
+from skmotion.io._text import decode_text, is_special, parse_number, read_text
 from skmotion.kinematics import Skeleton, euler_to_matrix
 
 __all__ = ["acclaim_order", "read_asf"]
@@ -53,10 +53,11 @@ class _Lines:
 
     def __init__(self, path):
         self.path = path
-        text = read_bytes(path).decode("latin-1")
+        text = decode_text(read_text(path))
         self.items = []
-        for number, line in enumerate(text.splitlines(), start=1):
-            words = line.split("#", 1)[0].split()
+        for number, line in enumerate(text.split("\n"), start=1):
+            words = line.split("#", 1)[0].replace("\t", " ").split(" ")
+            words = [w for w in words if w]
             if words:
                 self.items.append((number, words))
         self.pos = 0
@@ -78,7 +79,7 @@ class _Lines:
         if len(words) < count:
             raise self.error(line, f"{what} needs {count} values, found {len(words)}")
         try:
-            values = [float(w) for w in words[:count]]
+            values = [float(w) if is_special(w) else parse_number(w) for w in words[:count]]
         except ValueError:
             bad = next(w for w in words[:count] if not _is_number(w))
             raise self.error(line, f"non-numeric value {bad!r} in {what}") from None
@@ -89,7 +90,7 @@ class _Lines:
 
 def _is_number(word):
     try:
-        float(word)
+        float(word) if is_special(word) else parse_number(word)
     except ValueError:
         return False
     return True
@@ -244,12 +245,20 @@ def _build(lines, units, root, bones, children):
         name, parent = stack.pop()
         bone = bones[name]
         direction = np.asarray(bone["direction"], dtype=float)
-        norm = np.linalg.norm(direction)
-        if not norm > 0:
+        scale = np.abs(direction).max()
+        if not scale > 0:
             raise lines.error(bone["line"], f"bone {name!r} has a zero direction")
+        # Scaled to at most 1 before the norm, so 1e308 or 1e-308 components give the right unit.
+        direction = direction / scale
         # A bone's joint sits at the end of its parent bone; the root's bones start at the root.
         offset = vectors.get(names[parent], np.zeros(3))
-        vectors[name] = bone["length"] * direction / norm
+        vectors[name] = bone["length"] * direction / np.linalg.norm(direction)
+        with np.errstate(over="ignore"):
+            overflow = not np.isfinite(offset + vectors[name]).all()
+        if overflow:
+            raise lines.error(
+                bone["line"], f"bone {name!r}: its length {bone['length']:g} overflows a float"
+            )
         angles, axis_order = bone["axis"]
         # The three values are the x, y, z angles; the letters say in which order they apply.
         by_axis = dict(zip("XYZ", angles))
@@ -266,6 +275,13 @@ def _build(lines, units, root, bones, children):
     if missing:
         raise lines.error(None, f"bones {missing} are not connected to the root in the hierarchy")
     length = units.get("length")
+    try:
+        return _skeleton(names, parents, offsets, channels, orders, axes, length)
+    except ValueError as exc:
+        raise lines.error(None, f"the bones do not make a valid skeleton: {exc}") from None
+
+
+def _skeleton(names, parents, offsets, channels, orders, axes, length):
     return Skeleton(
         joints=names,
         parents=parents,

@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from skmotion.io._atomic import atomic_writer
 from skmotion.io._motion import Motion
 from skmotion.kinematics import euler_to_matrix, matrix_to_euler
 
@@ -38,10 +39,14 @@ def _joint_plan(skeleton):
         else:
             rotations = [f"{a}rotation" for a in order if a in axes]
             mode = "copy"
+        # Channels already in rotation order are written as listed (positions may come last).
+        verbatim = mode == "copy" and [f"{a}rotation" for a in axes] == rotations
         plan.append(
             {
-                "written": positions + rotations,
-                "sources": [columns[c] for c in positions]
+                "written": list(channels) if verbatim else positions + rotations,
+                "sources": [columns[c] for c in channels]
+                if verbatim
+                else [columns[c] for c in positions]
                 + ([] if mode == "matrix" else [columns[c] for c in rotations]),
                 "mode": mode,
                 "angles": [columns.get(f"{a}rotation") for a in order],
@@ -65,10 +70,10 @@ def _values(skeleton, channels, plan):
     blocks = []
     for j in _preorder(skeleton):
         step = plan[j]
-        n_pos = sum(c.endswith("position") for c in step["written"])
         if step["mode"] == "copy":
             block = channels[:, step["sources"]].copy()
-            block[:, n_pos:] = np.rad2deg(block[:, n_pos:])
+            angles = [c.endswith("rotation") for c in step["written"]]
+            block[:, angles] = np.rad2deg(block[:, angles])
         else:
             angles = np.zeros((len(channels), 3))
             for k, col in enumerate(step["angles"]):
@@ -84,32 +89,97 @@ def _values(skeleton, channels, plan):
     return np.hstack(blocks) if blocks else np.empty((len(channels), 0))
 
 
-def _hierarchy(skeleton, plan, number):
-    lines = ["HIERARCHY"]
-    children = [skeleton.children(j) for j in range(skeleton.n_joints)]
+def _end_site_names(skeleton):
+    """Joints to write as ``End Site``: channel-less leaves whose name read_bvh would give.
 
-    def write(j, depth):
-        pad = "  " * depth
+    read_bvh names an End Site ``<parent>_end`` (``_end2``, ... when taken); any other
+    channel-less leaf is written as a JOINT with ``CHANNELS 0`` so it keeps its name.
+    """
+    sites, seen = set(), set()
+    for j in _preorder(skeleton):
+        name = skeleton.joints[j]
+        if j and not skeleton.channels[j] and not skeleton.children(j):
+            parent = skeleton.joints[skeleton.parents[j]]
+            expected, suffix = f"{parent}_end", 2
+            while expected in seen:
+                expected, suffix = f"{parent}_end{suffix}", suffix + 1
+            if name == expected:
+                sites.add(j)
+        seen.add(name)
+    return sites
+
+
+def _hierarchy(skeleton, plan, number):
+    """The HIERARCHY lines, written with an explicit stack (any depth)."""
+    lines = ["HIERARCHY"]
+    sites = _end_site_names(skeleton)
+    stack = [(0, 0, False)]
+    while stack:
+        j, depth, closing = stack.pop()
+        pad = "  " * min(depth, 32)  # deep chains: indentation is capped, not the depth
+        if closing:
+            lines.append(f"{pad}}}")
+            continue
         offset = " ".join(number(v) for v in skeleton.offsets[j])
-        if not children[j] and not skeleton.channels[j] and j != 0:
+        if j in sites:
             lines.extend([f"{pad}End Site", f"{pad}{{", f"{pad}  OFFSET {offset}", f"{pad}}}"])
-            return
-        keyword = "ROOT" if j == 0 else "JOINT"
+            continue
         written = plan[j]["written"]
         lines.extend(
             [
-                f"{pad}{keyword} {skeleton.joints[j]}",
+                f"{pad}{'ROOT' if j == 0 else 'JOINT'} {skeleton.joints[j]}",
                 f"{pad}{{",
                 f"{pad}  OFFSET {offset}",
                 f"{pad}  CHANNELS {len(written)}" + "".join(f" {c}" for c in written),
             ]
         )
-        for child in children[j]:
-            write(child, depth + 1)
-        lines.append(f"{pad}}}")
-
-    write(0, 0)
+        stack.append((j, depth, True))
+        stack.extend((child, depth + 1, False) for child in reversed(skeleton.children(j)))
     return lines
+
+
+def _check_names(skeleton):
+    """Names read_bvh reads back verbatim: a line's rest, no braces or blanks at the ends."""
+    for j, name in enumerate(skeleton.joints):
+        problem = None
+        if not name.strip(" \t"):
+            problem = "is empty"
+        elif name != name.strip(" \t"):
+            problem = "starts or ends with a blank"
+        elif "{" in name or "}" in name:
+            problem = "contains a brace"
+        elif any(ord(c) < 32 or ord(c) == 127 for c in name if c != "\t"):
+            problem = "contains a line break or a control character"
+        if problem:
+            raise ValueError(
+                f"Joint {j} name {name!r} {problem}: BVH cannot store it (read_bvh takes a "
+                "joint's name as the rest of its line)."
+            )
+
+
+def _check_values(values, names):
+    """Every value to write is finite (in the file's unit: degrees for angles)."""
+    if not len(values):
+        raise ValueError("The motion has no frames: a BVH file needs at least one.")
+    if not values.shape[1]:
+        raise ValueError("The skeleton has no channels: a BVH file needs at least one.")
+    bad = ~np.isfinite(values)
+    if bad.any():
+        frame, column = np.argwhere(bad)[0]
+        raise ValueError(
+            f"Frame {frame}, channel {names[column]!r} is {float(values[frame, column])!r} "
+            "when written "
+            f"({int(bad.sum())} non-finite values): BVH files hold finite numbers only."
+        )
+
+
+def _written_names(skeleton, plan):
+    return [f"{skeleton.joints[j]}_{c}" for j in _preorder(skeleton) for c in plan[j]["written"]]
+
+
+def _write_frames(fh, values, fmt):
+    """The frame lines (a function of its own so tests can make it fail midway)."""
+    np.savetxt(fh, values, fmt=fmt, delimiter=" ")
 
 
 def write_bvh(motion, path, *, precision=None):
@@ -118,8 +188,14 @@ def write_bvh(motion, path, *, precision=None):
     Angles are written in degrees. Joints of skeletons with bone axes (read
     from ASF) are written with three rotation channels holding their whole
     local rotation, so the written file poses every joint exactly as the
-    motion does. End sites (joints with neither channels nor children) become
-    ``End Site`` blocks.
+    motion does. End sites (joints with neither channels nor children) named
+    as :func:`read_bvh` names them (``<parent>_end``) become ``End Site``
+    blocks; other channel-less leaves are written as joints with
+    ``CHANNELS 0``, so every name reads back unchanged.
+
+    The file is written to a temporary name in the same folder and renamed
+    over ``path`` at the end: an interrupted write (disk full, an exception)
+    leaves any previous file intact.
 
     Parameters
     ----------
@@ -131,6 +207,15 @@ def write_bvh(motion, path, *, precision=None):
         Decimals of the written values; ``None`` writes every value with 17
         significant digits, so that reading the file back gives the channels
         to within rounding of the degree conversion.
+
+    Raises
+    ------
+    ValueError
+        Before anything is written, for what BVH cannot store or read_bvh would
+        read back differently: an empty joint name, one with a brace, a line
+        break or blanks at its ends (spaces inside a name are kept); a NaN or
+        infinite channel value (naming its frame and channel); no frames; no
+        channels.
 
     See Also
     --------
@@ -157,10 +242,16 @@ def write_bvh(motion, path, *, precision=None):
         raise ValueError(f"precision must be a non-negative integer or None, got {precision!r}.")
     fmt = "%.17g" if precision is None else f"%.{int(precision)}f"
     skeleton = motion.skeleton
+    _check_names(skeleton)
     plan = _joint_plan(skeleton)
-    values = _values(skeleton, motion.channels, plan)
+    with np.errstate(over="ignore", invalid="ignore"):
+        values = _values(skeleton, motion.channels, plan)
+    _check_values(values, _written_names(skeleton, plan))
+    frame_time = 1.0 / motion.frame_rate
+    if not np.isfinite(frame_time) or not frame_time > 0:
+        raise ValueError(f"frame_rate {motion.frame_rate!r} has no finite positive frame time.")
     lines = _hierarchy(skeleton, plan, lambda v: fmt % v)
-    lines += ["MOTION", f"Frames: {motion.n_frames}", f"Frame Time: {1.0 / motion.frame_rate!r}"]
-    with open(path, "w", newline="\n") as fh:
+    lines += ["MOTION", f"Frames: {motion.n_frames}", f"Frame Time: {frame_time!r}"]
+    with atomic_writer(path) as fh:
         fh.write("\n".join(lines) + "\n")
-        np.savetxt(fh, values, fmt=fmt, delimiter=" ")
+        _write_frames(fh, values, fmt)

@@ -1,14 +1,16 @@
 """Reading the UEA/sktime ``.ts`` time-series classification format."""
 
+import re
 from pathlib import Path
 
 import numpy as np
 
 from skmotion.io._errors import MotionFileError
-from skmotion.io._text import read_bytes
+from skmotion.io._text import NUMBER, is_special, number_bytes_only, read_text
 
 __all__ = ["read_ts"]
 
+_DIGITS = re.compile(r"[0-9]+")
 _BOOLEAN_TAGS = ("timestamps", "missing", "univariate", "equallength")
 
 
@@ -16,66 +18,66 @@ def _parse_header(path, lines):
     """Header tags up to ``@data``; returns (tags, index of the first data line)."""
     tags = {}
     for number, raw in enumerate(lines, start=1):
-        line = raw.strip()
+        line = raw.strip(" \t")  # the text rule: blanks are spaces and tabs only
         if not line or line.startswith("#"):
             continue
         if not line.startswith("@"):
             raise MotionFileError(path, number, "data before the @data tag")
-        key, _, value = line[1:].partition(" ")
+        key, _, value = line[1:].replace("\t", " ").partition(" ")  # tabs separate too
         key = key.lower()
         if key == "data":
             return tags, number
-        value = value.strip()
+        value = value.strip(" \t")
         if key in _BOOLEAN_TAGS:
             if value.lower() not in ("true", "false"):
                 raise MotionFileError(path, number, f"@{key} must be true or false, got {value!r}")
             tags[key] = value.lower() == "true"
         elif key == "classlabel":
-            flag, _, labels = value.partition(" ")
+            flag, _, labels = value.replace("\t", " ").partition(" ")
             if flag.lower() not in ("true", "false"):
                 raise MotionFileError(
                     path, number, f"@classLabel must start with true or false, got {flag!r}"
                 )
-            tags["classlabel"] = labels.split() if flag.lower() == "true" else None
+            tags["classlabel"] = (
+                [w for w in labels.split(" ") if w] if flag.lower() == "true" else None
+            )
         elif key in ("dimensions", "serieslength"):
-            try:
-                tags[key] = int(value)
-            except ValueError:
-                raise MotionFileError(
-                    path, number, f"@{key} must be an integer, got {value!r}"
-                ) from None
+            if not _DIGITS.fullmatch(value):
+                raise MotionFileError(path, number, f"@{key} must be an integer, got {value!r}")
+            tags[key] = int(value)
         else:
             tags[key] = value
     raise MotionFileError(path, None, "no @data tag: not a .ts file")
 
 
 def _parse_dimension(path, number, index, text):
-    values = text.replace("?", "nan").split(",")
-    try:
-        column = np.array(values, dtype=float)
-    except ValueError:
-        bad = next(v for v in values if not _is_float(v))
-        raise MotionFileError(
-            path, number, f"dimension {index + 1}: non-numeric value {bad.strip()!r}"
-        ) from None
-    infinite = np.flatnonzero(np.isinf(column))
-    if infinite.size:
-        # NaN is a missing value (written '?'); an infinity is a broken value.
-        raise MotionFileError(
-            path,
-            number,
-            f"dimension {index + 1}: non-finite value {values[infinite[0]].strip()!r} "
-            f"at position {infinite[0] + 1} (write missing values as '?')",
-        )
-    return column
-
-
-def _is_float(text):
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
+    values = [v.strip(" \t") for v in text.split(",")]
+    column = None
+    # Only digits, signs, dots, exponents and '?': float() alone would take '1_0' or 'inf'.
+    if number_bytes_only(text.replace(",", " ").replace("?", " ").encode("utf-8")):
+        try:
+            column = np.array(["nan" if v == "?" else v for v in values], dtype=float)
+        except ValueError:
+            column = None
+    if column is not None and not np.isinf(column).any():
+        return column
+    for position, value in enumerate(values, start=1):
+        if value == "?":
+            continue
+        number_like = NUMBER.fullmatch(value) is not None
+        if is_special(value) or (number_like and not np.isfinite(float(value))):
+            # NaN is a missing value (written '?'); an infinity is a broken value.
+            raise MotionFileError(
+                path,
+                number,
+                f"dimension {index + 1}: non-finite value {value!r} at position {position} "
+                "(write missing values as '?')",
+            )
+        if not number_like:
+            raise MotionFileError(
+                path, number, f"dimension {index + 1}: non-numeric value {value!r}"
+            )
+    raise MotionFileError(path, number, f"dimension {index + 1}: values that cannot be read")
 
 
 def read_ts(path):
@@ -122,7 +124,7 @@ def read_ts(path):
     """
     path = Path(path)
     try:
-        lines = read_bytes(path).decode("utf-8").splitlines()
+        lines = read_text(path).decode("utf-8").split("\n")
     except UnicodeDecodeError as exc:
         raise MotionFileError(path, None, f"not a text file ({exc.reason})") from None
     tags, data_line = _parse_header(path, lines)
@@ -132,12 +134,12 @@ def read_ts(path):
     n_dims = tags.get("dimensions", 1 if tags.get("univariate") else None)
     clips, labels = [], []
     for number in range(data_line + 1, len(lines) + 1):
-        line = lines[number - 1].strip()
+        line = lines[number - 1].strip(" \t")
         if not line or line.startswith("#"):
             continue
         fields = line.split(":")
         if class_labels is not None:
-            label = fields.pop().strip()
+            label = fields.pop().strip(" \t")
             if label not in class_labels:
                 raise MotionFileError(
                     path,

@@ -22,6 +22,7 @@ from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_
 from skmotion.neighbors._store import GrowableStore
 from skmotion.neighbors._widths import learn_delta, radius_for_recall
 from skmotion.utils._clips import check_clips
+from skmotion.utils._labels import check_label_types
 from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
@@ -298,6 +299,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     def _check_labels(self, y, n, *, known=False):
         # Labels that must be among classes_ (known=True) are checked against
         # them instead: type_of_target costs milliseconds, a clip insertion less.
+        check_label_types(y)
         if not known:
             check_classification_targets(y)
         y = column_or_1d(y, warn=True)

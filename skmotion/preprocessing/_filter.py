@@ -23,6 +23,24 @@ def _design(order, cutoff):
     return butter(order, cutoff, btype="lowpass", output="sos")
 
 
+def _check_design(sos, order, cutoff):
+    """Refuse a design that double precision cannot hold (its gain at 0 Hz is not 1).
+
+    At very low cutoffs the poles crowd 1 and the sections lose their digits; the
+    filter's initial state then solves a singular system. A design whose DC gain
+    is off by more than 1e-6 is refused with the reason, not run.
+    """
+    with np.errstate(all="ignore"):
+        gain = np.prod(sos[:, :3].sum(axis=1) / sos[:, 3:].sum(axis=1))
+    if not abs(gain - 1.0) <= 1e-6:
+        raise ValueError(
+            f"cutoff={cutoff!r} is too low for an order-{order} Butterworth filter in double "
+            f"precision (its gain at 0 Hz is {gain:.6g}, not 1). Use a cutoff of at least "
+            "about 1e-5 (a fraction of the Nyquist frequency), a lower order, or resample the "
+            "clips to a lower frame rate first."
+        )
+
+
 def _padlen(sos):
     # scipy's default for sosfiltfilt: the signal is extended by this many
     # frames at each end (odd reflection) before filtering forward and back.
@@ -96,6 +114,7 @@ def lowpass_filter(clip, *, order=10, cutoff=0.25):
     True
     """
     sos = _design(order, cutoff).copy()  # scipy's filter wants a writable array
+    _check_design(sos, order, cutoff)
     needed = _padlen(sos) + 1
     if len(clip) < needed:
         raise ValueError(
@@ -188,6 +207,7 @@ class LowPassFilter(ClipTransformerMixin, BaseEstimator):
         self : LowPassFilter
             The fitted transformer.
         """
+        _check_design(_design(self.order, self.cutoff), self.order, self.cutoff)
         check_clips(X, estimator=self, reset=True)
         return self
 

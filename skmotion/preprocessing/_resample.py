@@ -1,5 +1,6 @@
 """Resampling clips in time: to a fixed length or to another frame rate."""
 
+import os
 from numbers import Integral, Real
 
 import numpy as np
@@ -13,6 +14,14 @@ from skmotion.utils._features import channel_names_in
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["ResampleClips", "resample_clip"]
+
+
+def _memory_bytes():
+    """Physical memory of the machine, or None where the OS does not say."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return None
 
 
 def resample_clip(clip, times, kind="linear"):
@@ -121,6 +130,12 @@ class ResampleClips(ClipTransformerMixin, BaseEstimator):
         self : ResampleClips
             The fitted transformer.
         """
+        if isinstance(self.n_frames, (bool, np.bool_)):
+            # bool is an Integral to Python: True would silently mean one frame.
+            raise TypeError(
+                f"The 'n_frames' parameter of ResampleClips must be an int in the range "
+                f"[1, inf) or None, not a bool (got {self.n_frames!r})."
+            )
         by_length = self.n_frames is not None
         by_rate = self.target_frame_rate is not None
         if by_length == by_rate:
@@ -149,15 +164,37 @@ class ResampleClips(ClipTransformerMixin, BaseEstimator):
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
+        self._check_output_size(clips)
         out = [resample_clip(c, self._positions(len(c)), self.kind) for c in clips]
         return self._wrap_clips(out, clips)
+
+    def _n_out(self, n):
+        """Frames of the resampled clip of ``n`` frames."""
+        if self.n_frames is not None:
+            return int(self.n_frames)
+        ratio = self.frame_rate / self.target_frame_rate
+        return int(np.floor((n - 1) / ratio + 1e-9)) + 1
 
     def _positions(self, n):
         if self.n_frames is not None:
             return np.linspace(0.0, n - 1.0, self.n_frames)
         ratio = self.frame_rate / self.target_frame_rate
-        n_out = int(np.floor((n - 1) / ratio + 1e-9)) + 1
-        return np.minimum(np.arange(n_out) * ratio, n - 1.0)
+        return np.minimum(np.arange(self._n_out(n)) * ratio, n - 1.0)
+
+    def _check_output_size(self, clips):
+        """Refuse, before allocating, an output larger than the machine's memory."""
+        n_out = np.array([self._n_out(len(c)) for c in clips], dtype=float)
+        width = clips[0].shape[1] if len(clips) else 0
+        # The output, plus the interpolation's temporaries for the largest clip.
+        needed = 8.0 * (n_out.sum() * width + 4 * n_out.max(initial=0) * (width + 1))
+        limit = _memory_bytes()
+        if limit is not None and needed > limit:
+            k = int(np.argmax(n_out))
+            raise ValueError(
+                f"ResampleClips would need {needed / 2**30:.1f} GiB (clip {k} alone becomes "
+                f"{int(n_out[k])} frames x {width} channels), more than this machine's "
+                f"{limit / 2**30:.1f} GiB of memory; lower n_frames or target_frame_rate."
+            )
 
     def get_feature_names_out(self, input_features=None):
         """Output channel names: the input's.

@@ -16,6 +16,7 @@ from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._split import SPLIT_CRITERIA
 from skmotion.tree._transitions import TransitionGraphs
 from skmotion.utils._clips import check_clips, stack_clips
+from skmotion.utils._labels import check_label_types
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["MotionTreeHMM"]
@@ -261,7 +262,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             The fitted model.
         """
         clips = check_clips(X, estimator=self, reset=True)
-        y = column_or_1d(np.asarray(y), warn=True)
+        y = column_or_1d(np.asarray(check_label_types(y)), warn=True)
         if len(y) != len(clips):
             raise ValueError(
                 f"y has {len(y)} labels but X holds {len(clips)} clips; give one label per clip."

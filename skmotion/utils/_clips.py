@@ -134,6 +134,13 @@ def _collection_from_dataframe(X, input_name):
     if len(X) == 0:
         raise ValueError(f"{input_name} is an empty collection: it holds no clips.")
     codes, labels = pd.factorize(index.get_level_values(0), sort=False)
+    for level, what in ((codes, "clip"), (index.codes[1], "frame")):
+        if (level < 0).any():  # pandas codes a missing label (NaN, None) as -1
+            row = int(np.flatnonzero(level < 0)[0])
+            raise ValueError(
+                f"{input_name}: row {row} of the DataFrame has a missing {what} label (NaN) in "
+                "its (clip, frame) index; every row needs a clip and a frame label."
+            )
     starts = np.flatnonzero(np.r_[True, codes[1:] != codes[:-1]])
     if len(starts) != len(labels):
         repeated = labels[np.bincount(codes[starts]).argmax()]
@@ -199,7 +206,7 @@ def _check_feature_names(X, estimator, reset, input_name):
 
 
 def _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name):
-    """The clips of a collection as C-contiguous float arrays, checked one by one; and their channel count."""
+    """The clips as C-contiguous float arrays, checked one by one; and their channel count."""
     clips = []
     n_channels = None
     for i, clip in enumerate(raw):
@@ -311,7 +318,7 @@ def check_clips(
     >>> check_clips([np.zeros((5, 3)), np.ones((8, 2))])
     Traceback (most recent call last):
     ...
-    ValueError: X: clip 1 has 2 channels, but clip 0 has 3; all clips of a collection share their channels.
+    ValueError: X: clip 1 has 2 channels, but clip 0 has 3; all clips of a collection ...
     """
     dtypes = _normalise_dtypes(dtype)
     name = _estimator_name(estimator)

@@ -54,6 +54,11 @@ def mutations(draw, data):
     return f"{kind} at byte {start}", data[:start] + word + data[end:]
 
 
+def _words(text):
+    """Words separated by spaces, tabs and line breaks only (not Python's Unicode blanks)."""
+    return [w for w in re.split(r"[ \t\r\n]+", text) if w]
+
+
 def _floats(words):
     values = np.array([float(w) for w in words], dtype=float)  # a word raises ValueError
     assert np.isfinite(values).all(), "the reference read a non-finite value"
@@ -65,7 +70,7 @@ def bvh_reference(text):
     header, motion = re.split(r"^\s*MOTION\b", text, maxsplit=1, flags=re.M | re.I)
     n_channels = sum(int(n) for n in re.findall(r"CHANNELS\s+(\d+)", header, flags=re.I))
     found = re.match(r"\s*Frames:[ \t]*(\d+)[ \t]*\r?\n\s*Frame Time:[^\n]*", motion, flags=re.I)
-    values = _floats(motion[found.end() :].split())
+    values = _floats(_words(motion[found.end() :]))
     return int(found.group(1)), n_channels, values
 
 
@@ -86,8 +91,8 @@ def check_amc(motion, text):
     rotations = np.array([name.endswith("rotation") for name in skeleton.channel_names])
     degrees = ":RADIANS" not in text.upper()
     frame, n_values = -1, 0
-    for line in text.splitlines():
-        words = line.split()
+    for line in text.split("\n"):  # the readers' rule: LF ends a line, blanks are space and tab
+        words = _words(line)
         if not words or words[0].startswith((":", "#")):
             continue
         if len(words) == 1 and words[0].isdigit():
@@ -113,7 +118,8 @@ def check_asf(skeleton, text):
 
 def check_ts(result, text):
     clips, labels = result
-    data = [line.strip() for line in text.split("@data", 1)[1].splitlines()]
+    body = re.split(r"^[ \t]*@data", text, maxsplit=1, flags=re.I | re.M)[1]  # tags: any case
+    data = [line.strip(" \t\r") for line in body.split("\n")]
     data = [line for line in data if line and not line.startswith("#")]
     assert len(clips) == len(data)
     for clip, line in zip(clips, data):

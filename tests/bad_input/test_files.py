@@ -38,7 +38,7 @@ HAND_MADE = [
         "binary junk as BVH",
         "bvh",
         bytes(range(256)) * 4,
-        r"no MOTION block \(not a BVH file, or truncated\)",
+        r"line 1: not a text file: control byte b'\\x00'",
     ),
     (
         "BVH: no frames",
@@ -87,7 +87,7 @@ HAND_MADE = [
         "binary junk as ASF",
         "asf",
         bytes(range(256)) * 4,
-        r"line 1: expected a ':section' keyword, found '\\x00",
+        r"line 1: not a text file: control byte b'\\x00'",
     ),
     (
         "ASF: length a word",

@@ -134,10 +134,10 @@ def test_fetch_downloads_then_reuses_the_cache(tmp_path, rng, monkeypatch):
     data = fetch_cmu_mocap(5, data_home=tmp_path)
     assert data.trials.tolist() == ["05_01", "05_02"]
     assert server.requests == [
-        "http://mocap.cs.cmu.edu/subjects/05/05.asf",
-        "http://mocap.cs.cmu.edu/subjects/05/05_01.amc",
-        "http://mocap.cs.cmu.edu/subjects/05/05_02.amc",
-        "http://mocap.cs.cmu.edu/subjects/05/05_03.amc",
+        "https://mocap.cs.cmu.edu/subjects/05/05.asf",
+        "https://mocap.cs.cmu.edu/subjects/05/05_01.amc",
+        "https://mocap.cs.cmu.edu/subjects/05/05_02.amc",
+        "https://mocap.cs.cmu.edu/subjects/05/05_03.amc",
     ]
     assert sorted(p.name for p in (tmp_path / "cmu-asfamc" / "05").iterdir() if p.suffix) == [
         "05.asf",
@@ -168,7 +168,7 @@ def test_fetch_uses_local_files_without_network(tmp_path, rng, monkeypatch):
     assert data.trials.tolist() == ["05_01", "05_02"] and data.description[1] == "jump - high"
     with pytest.raises(
         ConnectionError,
-        match=r"Could not download http://mocap.cs.cmu.edu/subjects/05/05_03.amc "
+        match=r"Could not download https://mocap.cs.cmu.edu/subjects/05/05_03.amc "
         r"\(network is unreachable\).*place the files in .*05",
     ):
         fetch_cmu_mocap([5], trials=[3], data_home=tmp_path / "home")

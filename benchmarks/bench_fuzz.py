@@ -1,0 +1,145 @@
+"""Fuzzing every reader with a large budget, and the cost of read_bvh's error path.
+
+Part 1 runs the engine of ``tests/bad_input/test_fuzz.py`` (random byte mutations of
+written and real files, each read with a time limit) with many more cases, and writes
+per source how many mutated files were tried, rejected with the reader's own
+``MotionFileError``, read in agreement with a plain-text reference, read equal to the
+original after a layout-only change, and failed (any other outcome: must be 0).
+
+Part 2 writes a large BVH file (``--mb``, default 20; the issue's figure is 100) and
+reads it valid and with one error near its end (a word, ``1_000``, a short frame line,
+missing frames, a NUL byte), each in a fresh process, recording seconds and peak
+memory: the error path should cost about what the valid path does.
+
+    python benchmarks/bench_fuzz.py                  # 1,500 cases per source, a 20 MB file
+    python benchmarks/bench_fuzz.py --cases 200 --mb 5   # quick
+    python benchmarks/bench_fuzz.py --mb 100         # the issue's size
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from _common import SHARED_DATA, write_results
+
+from tests.bad_input import fuzz
+from tests.bad_input.long_inputs import write_long_bvh
+
+_READ = """
+import json, sys, time
+from skmotion.io import MotionFileError, read_bvh
+start = time.perf_counter()
+try:
+    read_bvh(sys.argv[1], up_axis="y")
+    outcome = "read"
+except MotionFileError as error:
+    outcome = f"MotionFileError at line {error.line}: {error.message[:60]}"
+seconds = time.perf_counter() - start
+# VmHWM: this process's peak resident memory (ru_maxrss would include the parent's,
+# which Linux carries across exec).
+status = open("/proc/self/status").read()
+peak = int(status.split("VmHWM:")[1].split()[0]) / 1024
+print(json.dumps({"seconds": seconds, "peak_mb": peak, "outcome": outcome}))
+"""
+
+
+def _shared_data():
+    folder = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
+    return folder if (folder / "cmu-asfamc" / "01").is_dir() else None
+
+
+def fuzz_counts(n_cases, seed):
+    shared = _shared_data()
+    with tempfile.TemporaryDirectory() as folder:
+        start = time.perf_counter()
+        tally = fuzz.fuzz(Path(folder), shared, n_cases=n_cases, seed=seed)
+        seconds = time.perf_counter() - start
+    rows = [{"source": name, **row} for name, row in sorted(tally.counts.items())]
+    rows.append(
+        {
+            "source": "all",
+            **{
+                k: sum(r[k] for r in rows)
+                for k in ("tried", "rejected", "agrees", "equal", "failure")
+            },
+        }
+    )
+    notes = (
+        f"{n_cases} random mutations per source, seed {seed}, {seconds:.0f} s. rejected: the "
+        "reader's MotionFileError naming file and line; agrees: read, equal to a plain-text "
+        "reference; equal: a layout-only change read equal to the original; failure: anything "
+        "else (another exception type, a hang, a disagreement)."
+    )
+    if shared is None:
+        notes += " Real files not found: written files only."
+    write_results("bench_fuzz", rows, notes=notes)
+    for failure in tally.failures[:20]:
+        print("FAILURE", failure)
+    return tally
+
+
+def _edits(text):
+    """The large file with one error near its end: (name, bytes)."""
+    head, last = text.rstrip(b"\n").rsplit(b"\n", 1)
+    values = last.split(b" ")
+    frames = text.split(b"Frames: ", 1)[1].split(b"\n", 1)[0]
+    return [
+        ("valid", text),
+        ("a word in the last frame", head + b"\n" + b" ".join([b"ninety"] + values[1:]) + b"\n"),
+        ("1_000 in the last frame", head + b"\n" + b" ".join([b"1_000"] + values[1:]) + b"\n"),
+        ("last frame one value short", head + b"\n" + b" ".join(values[1:]) + b"\n"),
+        ("10 frames missing (truncated)", b"\n".join(text.split(b"\n")[:-11]) + b"\n"),
+        ("a NUL byte in the last frame", head + b"\n" + b"\x00" + last + b"\n"),
+        (
+            "Frames: one more than written",
+            text.replace(b"Frames: " + frames, b"Frames: %d" % (int(frames) + 1), 1),
+        ),
+    ]
+
+
+def error_path(megabytes):
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        base = Path(folder) / "large.bvh"
+        write_long_bvh(base, int(megabytes * 1e6 / 480), precision=4)
+        text = base.read_bytes()
+        for name, data in _edits(text):
+            path = Path(folder) / "case.bvh"
+            path.write_bytes(data)
+            result = subprocess.run(
+                [sys.executable, "-c", _READ, str(path)], capture_output=True, text=True, check=True
+            )
+            row = json.loads(result.stdout)
+            rows.append({"file": name, "MB": len(data) / 1e6, **row})
+    valid = rows[0]
+    for row in rows:
+        row["time / valid"] = row["seconds"] / valid["seconds"]
+        row["memory / valid"] = row["peak_mb"] / valid["peak_mb"]
+    write_results(
+        "bench_fuzz_error_path",
+        rows,
+        notes="read_bvh of one large file, valid and with one error near its end; each read in "
+        "a fresh process (peak = VmHWM, the process's peak resident memory, imports "
+        "included). The machine was shared: compare the ratios.",
+    )
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--cases", type=int, default=1500, help="mutations per source (0: none)")
+    parser.add_argument("--seed", type=int, default=2026)
+    parser.add_argument("--mb", type=float, default=20.0, help="size of the large BVH file")
+    args = parser.parse_args()
+    failures = fuzz_counts(args.cases, args.seed).failures if args.cases > 0 else []
+    if args.mb > 0:
+        error_path(args.mb)
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
