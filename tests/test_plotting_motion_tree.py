@@ -38,7 +38,9 @@ def test_edges_are_the_likely_transitions(model):
 
 
 def test_layers_and_profiles(model):
-    assert len(plotting.plot_motion_tree_layers(model.tree_, layers=[1, 2]).axes) == 2
+    assert (
+        len(plotting.plot_motion_tree_layers(model.tree_, layers=[1, 2]).axes) == 4
+    )  # + colour bars
     profile = np.array([[0.2, 0.5, 0.3], [0.1, 0.1, 0.8]])
     ax = plotting.plot_motion_tree_profile(profile, model.classes_, step=4, frame_rate=2.0)
     for column, line in enumerate(ax.get_lines()):

@@ -106,4 +106,10 @@ def _marker_clips(context):
 
 
 def run(context):
+    if getattr(context, "data_folder", None):
+        skipped = [
+            "repeated-motion benchmark (make_repeated_motions): skipped, it needs every motion "
+            "performed several times by design; the folder's own clips are indexed below"
+        ]
+        return skipped + _marker_clips(context)
     return _repeated_motions(context) + _marker_clips(context)

@@ -38,8 +38,10 @@ def _label_axes(ax, body):
 def _set_limits(ax, points, up):
     """Equal scale on every axis, around all the points drawn."""
     low, high = points.min(axis=0), points.max(axis=0)
-    margin = 0.05 * max(float((high - low).max()), 1e-9)
-    low, high = low - margin, high + margin
+    largest = max(float((high - low).max()), 1e-9)
+    # Every axis spans at least 40% of the largest (a pose is tall and thin), plus a margin.
+    half = np.maximum((high - low) / 2, 0.2 * largest) + 0.05 * largest
+    low, high = (low + high) / 2 - half, (low + high) / 2 + half
     if up is None:
         ax.set_xlim(low[0], high[0])
         ax.set_ylim(low[1], high[1])
@@ -48,7 +50,11 @@ def _set_limits(ax, points, up):
     for setter, axis in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), order):
         setter(low[axis], high[axis])
     # The box takes the data's proportions, so a metre is as long on every axis.
-    ax.set_box_aspect([float(high[a] - low[a]) for a in order])
+    sizes = [float(high[a] - low[a]) for a in order]
+    ax.set_box_aspect(sizes)
+    for axis, size in zip((ax.xaxis, ax.yaxis, ax.zaxis), sizes):
+        if size < 0.6 * max(sizes):  # a short axis: few ticks, or their labels overlap
+            axis.set_major_locator(_pyplot().MaxNLocator(3))
 
 
 def _draw(ax, pose, body, color, **line):
@@ -223,7 +229,6 @@ def plot_clip(
     figure.colorbar(mappable, ax=ax, shrink=0.7, pad=0.15, label=label)
     if spread and body.up is not None:
         ax.view_init(elev=12, azim=-75)  # look across the row of poses
-        ax.yaxis.set_major_locator(plt.MaxNLocator(2))  # the row's thin depth axis
     _label_axes(ax, body)
     drawn = (body.positions[frames] + shift[:, None, :]).reshape(-1, dims)
     _set_limits(ax, np.vstack([drawn, path]) if spread == 0 else drawn, body.up)

@@ -154,6 +154,8 @@ def body_frames(frames, body=None, *, bones=None, up_axis=None):
         if not np.isfinite(positions).all():
             raise ValueError("joint angles contain NaN or infinity.")
         unit = "" if body.units in (None, "unknown") else str(body.units)
+        if body.meters_per_unit:  # draw in metres whatever the file's unit
+            positions, unit = positions * float(body.meters_per_unit), "m"
     else:
         n_joints = len(names) if names is not None else None
         if n_joints is None and bones is not None and np.ndim(bones) == 1:
