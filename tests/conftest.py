@@ -62,7 +62,7 @@ def shared_data():
 
 
 @pytest.fixture(scope="session")
-def demo_report():
+def demo_report(tmp_path_factory):
     """The output of ``skmotion demo``, run once for every test that reads it."""
     import contextlib
     import io
@@ -70,7 +70,8 @@ def demo_report():
     from skmotion.cli import main
 
     buffer = io.StringIO()
+    out = tmp_path_factory.mktemp("demo-out")
     with contextlib.redirect_stdout(buffer):
-        status = main(["demo"])
+        status = main(["demo", "--quiet", "--out", str(out)])
     assert status == 0
     return buffer.getvalue()
