@@ -16,7 +16,7 @@ from sklearn.model_selection import GroupKFold, LeaveOneGroupOut, StratifiedKFol
 
 from skmotion.utils import progress
 
-__all__ = ["Evaluation", "choose_evaluation", "confusion_lines"]
+__all__ = ["Evaluation", "choose_evaluation", "confusion_lines", "evaluation_of"]
 
 
 @dataclass
@@ -174,3 +174,14 @@ def confusion_lines(truth, predicted):
         row = [int(np.sum((truth == name) & (predicted == other))) for other in names]
         lines.append(f"  {name.rjust(width)} " + " ".join(str(v).rjust(5) for v in row))
     return lines
+
+
+def evaluation_of(context):
+    """The context's evaluation, chosen from its data when no section has chosen one yet."""
+    if getattr(context, "evaluation", None) is None:
+        data = context.data
+        names = np.asarray(data.target_names)[data.target]
+        context.evaluation = choose_evaluation(
+            names, data.groups, data.get("subject_names"), random_state=context.random_state
+        )
+    return context.evaluation

@@ -7,6 +7,7 @@ import sklearn
 from sklearn.model_selection import GridSearchCV, GroupKFold, cross_validate
 
 import skmotion
+from skmotion._demo._split import evaluation_of
 from skmotion.neighbors import IntervalIndexNeighbors
 
 TITLE = "Evaluation by subject, and persistence"
@@ -33,7 +34,7 @@ def _nested(context, clips, y, groups):
         {"epsilon": [0.5, 1.0]},
         cv=GroupKFold(n_subjects - 1),
     )
-    outer = context.evaluation.cv
+    outer = evaluation_of(context).cv
     # Metadata routing sends the outer training subjects on to the inner GroupKFold.
     with sklearn.config_context(enable_metadata_routing=True):
         result = cross_validate(
@@ -54,7 +55,7 @@ def run(context):
     data = context.data
     clips = [c[:, 6:] for c in data.clips]  # without the root's (or pelvis marker's) channels
     y, groups = np.asarray(data.target), np.asarray(data.groups)
-    evaluation = context.evaluation
+    evaluation = evaluation_of(context)
     n_subjects = len(np.unique(groups))
     if evaluation.kind == "subject" and n_subjects >= 3:
         line, model = _nested(context, clips, y, groups)

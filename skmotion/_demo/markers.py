@@ -1,4 +1,7 @@
-"""Demo section: virtual markers, one feature space for every skeleton (Yamane et al. 2011, III-A)."""
+"""Demo section: virtual markers, one feature space for every skeleton.
+
+The representation of Yamane, Yamaguchi and Nakamura (2011), section III-A.
+"""
 
 from collections import Counter
 
@@ -7,6 +10,7 @@ from sklearn.linear_model import RidgeClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
+from skmotion._demo._split import evaluation_of
 from skmotion._demo.data_folder import to_rate
 from skmotion.io import as_motions
 from skmotion.preprocessing import (
@@ -43,14 +47,14 @@ def run(context):
         + ", ".join(f"{k} {v:.2f}" for k, v in height.items())
         + f"; median horizontal pelvis speed {speed:.2f} heights/s",
     ]
-    evaluation = context.evaluation
+    evaluation = evaluation_of(context)
     if evaluation.kind is None:
         return lines + [f"ridge classifier on markers: not run ({evaluation.reason})"]
     model = make_pipeline(
         ResampleClips(n_frames=16), FlattenClips(), StandardScaler(), RidgeClassifier()
     )
     on_markers = evaluation.scores(
-        model, clips, data.target, verbose=context.verbose, desc="markers CV"
+        model, clips, data.target, verbose=getattr(context, "verbose", 0), desc="markers CV"
     )
     context.marker_accuracy = on_markers.mean()
     baseline = getattr(context, "baseline_accuracy", None)

@@ -37,7 +37,8 @@ def run(context):
         f"{plan.layer} with {model.n_nodes_[plan.layer]} nodes",
         "goal 2.0 m ahead and 1.0 m left:",
         f"  {plan.n_frames} frames ({plan.n_frames / plan.frame_rate:.1f} s) through "
-        f"{len(set(plan.nodes.tolist()))} nodes, log probability {plan.log_probability:.1f}, every transition seen in the data "
+        f"{len(set(plan.nodes.tolist()))} nodes, log probability {plan.log_probability:.1f}, "
+        "every transition seen in the data "
         f"({int(plan.seen_counts.min())}+ times)",
         f"  root ends at x={x:.2f} m, y={y:.2f} m ({plan.reached:.3f} m from the goal), search "
         f"{plan.search_seconds * 1000:.0f} ms; IK joint angles fit within "

@@ -6,6 +6,7 @@ import numpy as np
 from sklearn.linear_model import LogisticRegression
 from sklearn.pipeline import make_pipeline
 
+from skmotion._demo._split import evaluation_of
 from skmotion.control import ArmModel, KMeansPrimitiveController
 from skmotion.decomposition import EigenMovementPCA
 from skmotion.preprocessing import filter_min_frames, segment_clip
@@ -41,7 +42,7 @@ def _classifier_lines(context, data):
     skeleton = data.get("skeleton")
     n_root = len(skeleton.channels[0]) if skeleton is not None else 0
     angles = [c[:, n_root:] for c in data.clips]  # without the root's travel and heading
-    evaluation = context.evaluation
+    evaluation = evaluation_of(context)
     if evaluation.kind is None or len(evaluation.clips) < 20:
         why = evaluation.reason if evaluation.kind is None else f"{len(evaluation.clips)} clips"
         return [f"classifier on primitive usage: not run ({why}; it needs 20 clips or more)"]
@@ -51,7 +52,7 @@ def _classifier_lines(context, data):
         LogisticRegression(max_iter=2000),
     )
     scores = evaluation.scores(
-        model, angles, data.target, verbose=context.verbose, desc="primitives CV"
+        model, angles, data.target, verbose=getattr(context, "verbose", 0), desc="primitives CV"
     )
     context.primitive_accuracy = scores.mean()
     return [
@@ -118,7 +119,8 @@ def run(context):
     total = pca.projection_mse_ + controller.clustering_mse_
     lines = [
         f"right arm ({', '.join(names)}), degrees: energy segmentation (SEG-2) of "
-        f"{len(clips)} clips gives {pca.n_segments_} segments, {pca.n_segments_ / len(clips):.1f} per clip"
+        f"{len(clips)} clips gives {pca.n_segments_} segments, "
+        f"{pca.n_segments_ / len(clips):.1f} per clip"
         + ("" if order else " (clips too short for the order-10 low-pass: not filtered)"),
         f"{pca.n_components_} eigenmovements of {n_features} samples keep "
         f"{100 * pca.explained_variance_ratio_.sum():.2f}% of the variance; projection RMS "

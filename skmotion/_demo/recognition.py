@@ -3,7 +3,7 @@
 import numpy as np
 
 from skmotion._demo._figures import save_figure
-from skmotion._demo._split import confusion_lines
+from skmotion._demo._split import confusion_lines, evaluation_of
 from skmotion.tree import MotionTreeHMM
 from skmotion.utils import say
 
@@ -16,10 +16,11 @@ def run(context):
     # root's travel and heading removed, which say where a subject walked, not how it moved.
     clips = context.marker_clips
     names = np.asarray(data.target_names)[data.target]
-    if context.evaluation.kind is None:
-        return [f"not run: {context.evaluation.reason}"]
-    train, test, held_out = context.evaluation.holdout(names)
-    say(context.verbose, f"demo: fitting MotionTreeHMM on {len(train)} clips ...")
+    evaluation = evaluation_of(context)
+    if evaluation.kind is None:
+        return [f"not run: {evaluation.reason}"]
+    train, test, held_out = evaluation.holdout(names)
+    say(getattr(context, "verbose", 0), f"demo: fitting MotionTreeHMM on {len(train)} clips ...")
     model = MotionTreeHMM().fit([clips[i] for i in train], names[train])
     context.motion_tree = model
     predicted = model.predict([clips[i] for i in test])
@@ -32,16 +33,18 @@ def run(context):
     n_markers = clip.shape[1] // 6
     lines = [
         f"MotionTreeHMM (defaults: minimum-error splits, max_depth={model.max_depth}, "
-        f"min_samples_leaf={model.min_samples_leaf}) on {n_markers} virtual markers ({clip.shape[1]} channels)",
-        f"trained on {len(train)} clips, tested on {held_out} ({len(test)} clips): accuracy {accuracy:.3f}",
+        f"min_samples_leaf={model.min_samples_leaf}) on {n_markers} virtual markers "
+        f"({clip.shape[1]} channels)",
+        f"trained on {len(train)} clips, tested on {held_out} ({len(test)} clips): "
+        f"accuracy {accuracy:.3f}",
         *confusion_lines(names[test], predicted),
         f"tree: {int(tree.count[0]):,} frames, {tree.n_layers} layers, {tree.n_tree_nodes} nodes, "
         f"{int(tree.n_nodes[-1])} in the bottom layer",
         "nodes per layer: " + " ".join(str(int(n)) for n in tree.n_nodes),
-        f"state estimation, first {half_second} frames of a test {names[test[0]]}: bottom-layer nodes "
-        + " ".join(str(int(n)) for n in states[-6:])
-        + " (last six)",
-        f"prediction 5 frames ahead: node {int(ahead.nodes[0, 0])} with probability {ahead.probabilities[0, 0]:.2f}",
+        f"state estimation, first {half_second} frames of a test {names[test[0]]}: "
+        "bottom-layer nodes " + " ".join(str(int(n)) for n in states[-6:]) + " (last six)",
+        f"prediction 5 frames ahead: node {int(ahead.nodes[0, 0])} with probability "
+        f"{ahead.probabilities[0, 0]:.2f}",
     ]
     return lines + save_figure(
         context,
