@@ -9,6 +9,7 @@ from sklearn.model_selection import GridSearchCV, GroupKFold, cross_validate
 import skmotion
 from skmotion._demo._split import evaluation_of
 from skmotion.neighbors import IntervalIndexNeighbors
+from skmotion.utils import say
 
 TITLE = "Evaluation by subject, and persistence"
 
@@ -35,6 +36,8 @@ def _nested(context, clips, y, groups):
         cv=GroupKFold(n_subjects - 1),
     )
     outer = evaluation_of(context).cv
+    n_folds = outer.get_n_splits(groups=groups)
+    say(getattr(context, "verbose", 0), f"demo: nested CV, {n_folds} outer folds x 2 epsilons ...")
     # Metadata routing sends the outer training subjects on to the inner GroupKFold.
     with sklearn.config_context(enable_metadata_routing=True):
         result = cross_validate(

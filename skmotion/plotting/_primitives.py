@@ -14,7 +14,7 @@ def plot_eigenmovements(
     """The first eigenmovements, one row each, one panel per channel.
 
     Each panel shows how one channel moves over the normalised time of a
-    segment in one eigenmovement (the eigenmovement paper's Fig. 7). The panels
+    segment in one eigenmovement (Fod, Mataric and Jenkins 2002, Fig. 7). The panels
     of a row share their vertical scale, so a channel's share of the
     eigenmovement shows.
 

@@ -8,7 +8,7 @@ __all__ = ["plot_motion_tree_layer", "plot_motion_tree_layers", "plot_motion_tre
 
 
 def _node_spread(tree, layer):
-    """Largest standard deviation of each node (the paper sizes nodes by largest singular value)."""
+    """Largest standard deviation of each node (Yamane et al. size nodes by it)."""
     cov = tree.covariances(layer)
     if tree.covariance_type == "full":
         return np.sqrt(np.linalg.eigvalsh(cov)[:, -1])
@@ -126,7 +126,7 @@ def plot_motion_tree_layer(
 def plot_motion_tree_layers(
     tree, graphs=None, layers=None, *, graph=0, axes=(0, 1), min_probability=0.05
 ):
-    """Several layers side by side (the paper's Figure 5 shows layers 4 and 7).
+    """Several layers side by side (Yamane et al. 2011, Figure 5, show layers 4 and 7).
 
     Parameters
     ----------
@@ -169,7 +169,7 @@ def plot_motion_tree_layers(
 
 
 def plot_motion_tree_profile(profile, classes, *, step=1, frame_rate=None, ax=None):
-    """Class probabilities of sliding windows over one clip (the paper's Figures 10-12).
+    """Class probabilities of sliding windows over one clip (Yamane et al. 2011, Figs. 10-12).
 
     Parameters
     ----------
