@@ -60,7 +60,7 @@ def save_animation(context, filename, clip, body, frame_rate, description, *, se
     n_frames = min(len(clip), max(2, int(round(seconds * frame_rate))))
     step = max(1, int(round(frame_rate / 12)))  # about 12 pictures a second keeps the file small
     path = animate_clip(
-        clip[:n_frames], body, Path(out) / filename, frame_rate=frame_rate, step=step, dpi=60
+        clip[:n_frames], body, Path(out) / filename, frame_rate=frame_rate, step=step, dpi=80
     )
     context.figures.append((path, description))
     return [f"animation: {description} -> {path}"]

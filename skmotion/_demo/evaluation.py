@@ -25,18 +25,25 @@ def _persistence_line(model, clips):
 
 
 def _nested(context, clips, y, groups):
-    """Nested subject-wise CV: the outer split of the demo, an inner GroupKFold over epsilon."""
-    _, per_subject = np.unique(groups, return_counts=True)
-    n_subjects = len(per_subject)
-    # The smallest inner training set: all clips but the two largest subjects'.
-    fewest = len(clips) - np.sort(per_subject)[-2:].sum()
+    """Nested subject-wise CV: subjects held out outside, an inner GroupKFold over epsilon."""
+    n_subjects = len(np.unique(groups))
+    # Leave one subject out (valid: every class has 2 subjects or more), unless that is many.
+    outer = GroupKFold(n_subjects) if n_subjects <= 8 else evaluation_of(context).cv
+    folds = list(outer.split(clips, y, groups))
+    n_inner = min(5, min(len(np.unique(groups[train])) for train, _ in folds))
+    inner = GroupKFold(n_inner)
+    # The smallest inner training set bounds the index depth.
+    fewest = min(
+        len(inner_train)
+        for train, _ in folds
+        for inner_train, _ in inner.split(train, y[train], groups[train])
+    )
     search = GridSearchCV(
         IntervalIndexNeighbors(n_levels=int(max(1, min(5, fewest)))),
         {"epsilon": [0.5, 1.0]},
-        cv=GroupKFold(n_subjects - 1),
+        cv=inner,
     )
-    outer = evaluation_of(context).cv
-    n_folds = outer.get_n_splits(groups=groups)
+    n_folds = len(folds)
     say(getattr(context, "verbose", 0), f"demo: nested CV, {n_folds} outer folds x 2 epsilons ...")
     # Metadata routing sends the outer training subjects on to the inner GroupKFold.
     with sklearn.config_context(enable_metadata_routing=True):
@@ -44,10 +51,9 @@ def _nested(context, clips, y, groups):
             search, clips, y, cv=outer, params={"groups": groups}, return_estimator=True
         )
     chosen = [est.best_params_["epsilon"] for est in result["estimator"]]
-    n_outer = outer.get_n_splits(groups=groups)
     line = (
-        f"nested CV, interval index: outer {type(outer).__name__} by subject ({n_outer} folds), "
-        f"inner GroupKFold({n_subjects - 1}) over epsilon with groups routed: accuracy "
+        f"nested CV, interval index: outer {type(outer).__name__}({n_folds}) by subject, "
+        f"inner GroupKFold({n_inner}) over epsilon with groups routed: accuracy "
         f"{result['test_score'].mean():.3f} +/- {result['test_score'].std():.3f}; epsilon "
         f"chosen per outer fold {chosen}"
     )
