@@ -1,6 +1,7 @@
 """Shared fixtures: seeded generators, a small skeleton, ragged clips, real data."""
 
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -75,3 +76,12 @@ def demo_report(tmp_path_factory):
         status = main(["demo", "--quiet", "--out", str(out)])
     assert status == 0
     return buffer.getvalue()
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    """Close the figures a test drew (pyplot keeps them, and warns past 20)."""
+    yield
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot is not None:
+        pyplot.close("all")
