@@ -150,7 +150,7 @@ def _offsets(positions, body, spread):
     horizontal = 0 if body.up is None else _view_axes(body.up)[0]
     extent = float(np.ptp(positions.reshape(-1, positions.shape[2]), axis=0).max())
     root = positions[:, int(body.bones[0, 0]) if len(body.bones) else 0]
-    travel = float(np.linalg.norm(root[-1] - root[0]))
+    travel = float(np.ptp(root, axis=0).max())  # how far the root ranges, not end to end
     if spread is None:
         single = float(np.ptp(positions[0], axis=0).max())
         spread = 0.0 if travel > 0.5 * single else 0.7 * single
