@@ -206,3 +206,15 @@ def test_shared_data_gets_index_labels_and_a_possible_split(shared_data, sub):
         # the lone non-CMU clip is labelled from its file name, not its folder
         k = [i for i, f in enumerate(data.filenames) if "bvh-samples" in f][0]
         assert names[k] == "walk" and data.label_sources[k] == "file name"
+
+
+def test_progress_on_stderr_only_when_asked(tmp_path, capsys):
+    names = [f"walk/05_{t:02d}.bvh" for t in range(1, 4)] + [f"jump/06_{t:02d}.bvh" for t in (1, 2)]
+    root = _write_folder(tmp_path, names, ["walk", "jump"], index=False)
+    sections = ("skmotion._demo.data_folder",)
+    run_demo(lambda line: None, sections=sections, data_folder=str(root), verbose=1)
+    err = capsys.readouterr().err
+    assert "[skmotion] demo: Data: motion files ..." in err
+    assert re.search(r"\[skmotion\] baseline CV.*\d+/\d+", err)  # the folds, as they finish
+    run_demo(lambda line: None, sections=sections, data_folder=str(root))
+    assert capsys.readouterr().err == ""
