@@ -9,22 +9,52 @@ from skmotion import __version__
 __all__ = ["main"]
 
 
+def _demo_error(message):
+    print(f"skmotion demo: {message}", file=sys.stderr)
+    return 2
+
+
 def _demo(args):
+    from pathlib import Path
+
     from skmotion._demo import SECTIONS, run_demo
+    from skmotion._demo.data_folder import DemoDataError
 
     start = time.perf_counter()
-    print(f"skmotion {__version__} demo")
     options = {}
     sections = SECTIONS
     if args.data is not None:
+        folder = Path(args.data)
+        if not folder.is_dir():
+            what = "is a file, not a folder" if folder.exists() else "does not exist"
+            return _demo_error(f"--data {args.data} {what}")
+        if args.index is not None and not Path(args.index).is_file():
+            return _demo_error(f"--index {args.index}: no such file")
         sections = tuple(
             "skmotion._demo.data_folder" if s == "skmotion._demo.data" else s for s in SECTIONS
         )
-        options = {"data_folder": args.data, "frame_rate": args.frame_rate}
-    run_demo(
-        print, random_state=args.random_state, sections=sections, plot_dir=args.plots, **options
-    )
+        options = {"data_folder": args.data, "frame_rate": args.frame_rate, "index": args.index}
+    out = None if args.no_out else args.out
+    if out is not None:
+        try:
+            Path(out).mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            return _demo_error(f"cannot write the output folder --out {out}: {exc.strerror}")
+    print(f"skmotion {__version__} demo")
+    try:
+        context = run_demo(
+            print,
+            random_state=args.random_state,
+            sections=sections,
+            out=out,
+            verbose=0 if args.quiet else 1,
+            **options,
+        )
+    except DemoDataError as exc:
+        return _demo_error(str(exc))
     print("")
+    if context.report_path is not None:
+        print(f"figures and report.html (text and figures in one file) written to {Path(out)}/")
     print(f"done in {time.perf_counter() - start:.1f} s")
     return 0
 
@@ -71,8 +101,15 @@ def build_parser():
         "--data",
         metavar="FOLDER",
         default=None,
-        help="run on the motion files under FOLDER (BVH files and ASF/AMC subject folders; labels from "
-        "subfolder names or from a CMU index CSV at the top of FOLDER) instead of the synthetic data",
+        help="run on the motion files under FOLDER (BVH files and ASF/AMC subject folders, at "
+        "any depth) instead of the synthetic data; CMU trials (NN_TT files) are labelled from the "
+        "CMU index, other files by a motion keyword in their name, else by their folder",
+    )
+    demo.add_argument(
+        "--index",
+        metavar="CSV",
+        default=None,
+        help="with --data: the CMU index CSV (default: one found in FOLDER or a folder above it)",
     )
     demo.add_argument(
         "--frame-rate",
@@ -81,11 +118,15 @@ def build_parser():
         help="with --data: resample every clip to this rate (default 30 Hz)",
     )
     demo.add_argument(
-        "--plots",
+        "--out",
         metavar="DIR",
-        default=None,
-        help="save the sections' figures in DIR (needs matplotlib)",
+        default="skmotion-demo",
+        help="write the figures and report.html here (default ./skmotion-demo; figures need "
+        'matplotlib: pip install "skmotion[plot]")',
     )
+    demo.add_argument("--plots", dest="out", help=argparse.SUPPRESS)  # the old name of --out
+    demo.add_argument("--no-out", action="store_true", help="print the report only; write no files")
+    demo.add_argument("--quiet", action="store_true", help="no progress lines on standard error")
     demo.set_defaults(func=_demo)
     from skmotion.io._info import formats_help
 

@@ -1,6 +1,7 @@
 """Shared fixtures: seeded generators, a small skeleton, ragged clips, real data."""
 
 import os
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -62,7 +63,7 @@ def shared_data():
 
 
 @pytest.fixture(scope="session")
-def demo_report():
+def demo_report(tmp_path_factory):
     """The output of ``skmotion demo``, run once for every test that reads it."""
     import contextlib
     import io
@@ -70,7 +71,17 @@ def demo_report():
     from skmotion.cli import main
 
     buffer = io.StringIO()
+    out = tmp_path_factory.mktemp("demo-out")
     with contextlib.redirect_stdout(buffer):
-        status = main(["demo"])
+        status = main(["demo", "--quiet", "--out", str(out)])
     assert status == 0
     return buffer.getvalue()
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    """Close the figures a test drew (pyplot keeps them, and warns past 20)."""
+    yield
+    pyplot = sys.modules.get("matplotlib.pyplot")
+    if pyplot is not None:
+        pyplot.close("all")

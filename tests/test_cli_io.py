@@ -67,12 +67,16 @@ def test_demo_on_a_folder_of_files(tmp_path, capsys):
         folder = tmp_path / str(data.target_names[data.target[k]])
         folder.mkdir(exist_ok=True)
         write_bvh(motion, folder / f"{k:02d}_01.bvh")  # CMU-like names: subject k
-    assert main(["demo", "--data", str(tmp_path), "--frame-rate", "20"]) == 0
+    out_dir = tmp_path.parent / f"{tmp_path.name}-out"
+    assert main(["demo", "--data", str(tmp_path), "--frame-rate", "20", "--out", str(out_dir)]) == 0
     out = capsys.readouterr().out
     assert f"{tmp_path}: 6 clips (6 BVH, 0 ASF/AMC)" in out
     assert "recorded at 60 Hz" in out and "resampled to 20 Hz" in out
     assert "channels: 66 joint angles" in out
-    assert "classes (2): squat 3, walk 3" in out
+    # no index: labels from a keyword in the file name, else the folder (names 00_01 ... have none)
+    assert "classes (2): squat 3 (3 subj.), walk 3 (3 subj.)" in out
+    assert "0 from a keyword in the file name; 6 from the folder name (fallback)" in out
+    assert "evaluation: split by subject" in out
     assert "humanoid 6 clips" in out
 
 
@@ -90,7 +94,7 @@ def test_demo_on_the_shared_data(shared_data, capsys, monkeypatch):
         return data
 
     monkeypatch.setattr(data_folder, "load_motion_folder", smaller)
-    assert main(["demo", "--data", str(shared_data)]) == 0
+    assert main(["demo", "--data", str(shared_data), "--no-out", "--quiet"]) == 0
     out = capsys.readouterr().out
     assert (
         calls

@@ -1,13 +1,23 @@
-"""The conformance checks pass a correct estimator and catch broken ones."""
+"""The conformance checks pass a correct estimator and catch broken ones; every public
+estimator of skmotion is run through them."""
+
+import ast
+import importlib
+import inspect
+import pathlib
+import pkgutil
+import subprocess
+import sys
 
 import numpy as np
 import pytest
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
+import skmotion
 from skmotion.base import ClipEstimatorMixin
 from skmotion.utils import check_clips
-from tests import clip_conformance as cc
+from skmotion.utils import estimator_checks as cc
 
 
 class ClipMeanCentroid(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -130,3 +140,71 @@ def test_every_check_is_generated_once():
     assert len(ids) == len(set(ids)) == len(cc.CHECKS) + len(cc.SKLEARN_DATA_FREE_CHECKS)
     skipped = cc.ClipCase(ClipMeanCentroid(), _data, skip={"check_pickle": "reason"})
     assert "ClipMeanCentroid-check_pickle" not in [name for name, _ in cc.clip_checks(skipped)]
+
+
+def test_check_clip_estimator_runs_every_check_and_names_the_failure():
+    passed = cc.check_clip_estimator(ClipMeanCentroid(), _data)
+    assert len(passed) == len(cc.CHECKS) + len(cc.SKLEARN_DATA_FREE_CHECKS)
+    # a seedless estimator gives other results on every fit: the first check comparing two
+    # fits fails, and the message names it
+    with pytest.raises(AssertionError, match=r"IgnoresSeed-check_containers_agree failed"):
+        cc.check_clip_estimator(IgnoresSeed(), _data())
+    skipped = cc.check_clip_estimator(ClipMeanCentroid(), _data, skip={"check_pickle": "why"})
+    assert "ClipMeanCentroid-check_pickle" not in skipped and len(skipped) == len(passed) - 1
+
+
+def test_default_data_fits_the_estimator():
+    X, y = cc.make_check_data(ClipMeanCentroid())
+    assert len(X) == 9 and {c.shape[1] for c in X} == {10} and min(len(c) for c in X) >= 21
+    assert cc.check_clip_estimator(ClipMeanCentroid())  # no data given: the default
+
+
+def test_importing_the_checks_needs_no_pytest():
+    code = (
+        "import sys; sys.modules['pytest'] = None\n"  # any `import pytest` now fails
+        "from skmotion.utils.estimator_checks import check_clip_estimator\n"
+        "from skmotion.preprocessing import ResampleClips\n"
+        "print(len(check_clip_estimator(ResampleClips(n_frames=8))))"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    assert int(result.stdout) > 20
+
+
+def _public_estimators():
+    found = set()
+    for info in pkgutil.walk_packages(skmotion.__path__, "skmotion."):
+        if any(part.startswith("_") for part in info.name.split(".")[1:]):
+            continue
+        module = importlib.import_module(info.name)
+        for name in getattr(module, "__all__", []):
+            obj = getattr(module, name)
+            if inspect.isclass(obj) and issubclass(obj, BaseEstimator):
+                found.add(name)
+    return found
+
+
+def _checked_in_tests():
+    """Estimator classes constructed as the first argument of a ClipCase in tests/."""
+    names = set()
+    for path in pathlib.Path(__file__).parent.rglob("test_*.py"):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if (
+                isinstance(node, ast.Call)
+                and getattr(node.func, "attr", getattr(node.func, "id", None)) == "ClipCase"
+                and node.args
+                and isinstance(node.args[0], ast.Call)
+            ):
+                func = node.args[0].func
+                names.add(getattr(func, "id", getattr(func, "attr", None)))
+    return names
+
+
+def test_every_public_estimator_runs_the_checks():
+    estimators = _public_estimators()
+    assert {"MotionTreeHMM", "EigenMovementPCA", "ResampleClips"} <= estimators
+    missing = sorted(estimators - _checked_in_tests())
+    assert not missing, (
+        f"no ClipCase runs the clip conformance checks on {missing}: add one to its tests "
+        "with skmotion.utils.estimator_checks.parametrize_with_clip_checks"
+    )

@@ -25,7 +25,7 @@ def test_recognition_section(capsys):
     assert table.sum() == 21 and np.trace(table) / 21 == pytest.approx(accuracy, abs=1e-3)
     tree = context.motion_tree.tree_
     assert f"{tree.n_layers} layers, {tree.n_tree_nodes} nodes" in text
-    assert "--plots DIR" in text
+    assert "figure:" not in text  # no output folder: no figure
 
 
 def test_plots_are_saved(tmp_path):

@@ -43,8 +43,9 @@ def test_python_examples_run(page, tmp_path, monkeypatch):
 
 def test_readme_gives_the_two_setup_commands():
     text = (ROOT / "README.md").read_text()
-    assert "pip install . && skmotion demo" in text
+    assert 'pip install ".[plot]" && skmotion demo' in text
     assert 'pip install -e ".[test]" && pytest' in text
+    assert ". .venv-demo/bin/activate" in text and ". .venv-test/bin/activate" in text
 
 
 def test_architecture_lists_every_module():

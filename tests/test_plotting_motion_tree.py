@@ -38,9 +38,24 @@ def test_edges_are_the_likely_transitions(model):
 
 
 def test_layers_and_profiles(model):
-    assert len(plotting.plot_motion_tree_layers(model.tree_, layers=[1, 2]).axes) == 2
+    assert (
+        len(plotting.plot_motion_tree_layers(model.tree_, layers=[1, 2]).axes) == 4
+    )  # + colour bars
     profile = np.array([[0.2, 0.5, 0.3], [0.1, 0.1, 0.8]])
     ax = plotting.plot_motion_tree_profile(profile, model.classes_, step=4, frame_rate=2.0)
     for column, line in enumerate(ax.get_lines()):
         np.testing.assert_allclose(line.get_xdata(), [0.0, 2.0])
         np.testing.assert_allclose(line.get_ydata(), profile[:, column])
+
+
+def test_layer_figure_explains_sizes_colours_and_lines(model):
+    tree = model.tree_
+    ax = plotting.plot_motion_tree_layer(tree, model.global_graph_, layer=3)
+    labels = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert labels[0].startswith("node, small") and labels[-1] == "transition, p >= 0.05"
+    bar = ax.figure.axes[1]
+    assert bar.get_ylabel().startswith("node spread (largest std)")
+    # the colour scale spans the nodes' spreads
+    spreads = ax.collections[0].get_array()
+    low, high = ax.collections[0].get_clim()
+    assert low == pytest.approx(spreads.min()) and high == pytest.approx(spreads.max())

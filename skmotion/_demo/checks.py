@@ -22,7 +22,7 @@ def _message(call):
 
 
 def _truncated_bvh(motion, folder):
-    """The first 40 frames of a motion written as BVH, then cut in the middle of the 20th frame line."""
+    """The first 40 frames of a motion written as BVH, then cut in the middle of frame line 20."""
     path = Path(folder) / "walk.bvh"
     write_bvh(
         Motion(motion.skeleton, motion.channels[:40], frame_rate=motion.frame_rate),
@@ -38,15 +38,22 @@ def _truncated_bvh(motion, folder):
 
 def run(context):
     data = context.data
-    # One clip of the data (synthetic, or the first file of --data FOLDER) made bad in each way.
+    # The data's own clips (synthetic, or --data FOLDER's), made bad in each way.
+    on_folder = data.get("motions") is not None
     motion = (
         data.get("motions") or as_motions(data.clips[:1], data.skeletons[:1], data.frame_rate)
     )[0]
-    clip = motion.channels
-    with_nan = [clip.copy() for _ in range(4)]
-    with_nan[3][min(17, len(clip) - 1), min(8, clip.shape[1] - 1)] = np.nan
+    clip = data.clips[0]
+    with_nan = [c.copy() for c in data.clips[:4]]
+    bad = len(with_nan) - 1
+    with_nan[bad][min(17, len(with_nan[bad]) - 1), min(8, clip.shape[1] - 1)] = np.nan
+    source = (
+        f"the folder's first {len(with_nan)} clip(s) (from {Path(data.filenames[0]).name}, ...)"
+        if on_folder
+        else f"the first {len(with_nan)} synthetic clips"
+    )
     tried = [
-        ("NaN in a clip", lambda: MotionTreeHMM().fit(with_nan, [0, 1, 0, 1])),
+        ("NaN in a clip", lambda: MotionTreeHMM().fit(with_nan, [0, 1, 0, 1][: len(with_nan)])),
         ("channels differ", lambda: SVDFeatureExtractor().fit([clip, clip[:, :-2]])),
         ("predict before fit", lambda: MotionTreeHMM().predict([clip])),
         ("frame_rate 0", lambda: ResampleClips(frame_rate=0, target_frame_rate=30).fit([clip])),
@@ -58,6 +65,8 @@ def run(context):
         lines = [
             f"{what:>20}: {_message(call).replace(str(path), path.name)}" for what, call in tried
         ]
-    return lines + [
-        "(every estimator and reader, with many more cases: tests/bad_input/, docs/errors.md)"
-    ]
+    return (
+        [f"bad inputs made from {source}; the BVH from the first clip's motion:"]
+        + lines
+        + ["(every estimator and reader, with many more cases: tests/bad_input/, docs/errors.md)"]
+    )

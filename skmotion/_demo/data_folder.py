@@ -1,15 +1,93 @@
-"""Demo section (with ``skmotion demo --data FOLDER``): real motion files instead of the synthetic data."""
+"""Demo section (``skmotion demo --data FOLDER``): real motion files instead of synthetic data.
+
+Labels come from the CMU index wherever a file's name is a CMU trial (``02_01.amc``,
+``07_05.bvh``, at any depth): the trial's description mapped to a motion class by the
+keyword table of :mod:`skmotion.datasets._cmu_labels`. Other files are labelled by a
+keyword in their own name, and only then by their folder's name; the report counts each.
+"""
+
+import inspect
+import re
+from pathlib import Path
 
 import numpy as np
-from sklearn.model_selection import GroupKFold, cross_val_score
 from sklearn.neighbors import KNeighborsClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.utils import Bunch
 
-from skmotion.datasets import load_motion_folder
+from skmotion._demo._split import choose_evaluation
+from skmotion._demo.data import body_figures
+from skmotion.datasets import (
+    cmu_motion_class,
+    load_motion_folder,
+    motion_class_of_name,
+    read_cmu_index,
+)
 from skmotion.preprocessing import FlattenClips, ResampleClips, resample_clip, to_markers
 
 TITLE = "Data: motion files"
+
+_TRIAL = re.compile(r"^(\d+)_(\d+)$")
+_INDEX_COLUMNS = ("Subject", "Trial #", "Motion Description")
+
+
+class DemoDataError(ValueError):
+    """The demo's folder cannot be used (no such folder, no motion files, a bad file)."""
+
+
+def find_cmu_index(folder):
+    """A CMU index CSV in ``folder`` or the nearest folder above it, or None."""
+    for place in (Path(folder).resolve(), *Path(folder).resolve().parents):
+        for path in sorted(place.glob("*.csv")):
+            with path.open(errors="replace") as handle:
+                header = handle.readline()
+            if all(column in header for column in _INDEX_COLUMNS):
+                return path
+    return None
+
+
+def label_clips(filenames, root, index):
+    """Label, label source and subject of every file.
+
+    Returns
+    -------
+    labels, sources, subjects : lists of str
+        ``sources`` holds "CMU index", "file name" or "folder name" per file.
+    """
+    labels, sources, subjects = [], [], []
+    for name in filenames:
+        path = Path(name)
+        folder = path.parent.relative_to(root).as_posix() if path.parent != root else root.name
+        match = _TRIAL.match(path.stem)
+        trial = f"{int(match.group(1)):02d}_{int(match.group(2)):02d}" if match else None
+        subjects.append(trial.split("_")[0] if trial else folder)
+        if index is not None and trial in index.index:
+            labels.append(cmu_motion_class(index.loc[trial, "description"]))
+            sources.append("CMU index")
+        elif motion_class_of_name(path.stem):
+            labels.append(motion_class_of_name(path.stem))
+            sources.append("file name")
+        else:
+            labels.append(path.parent.name if path.parent != root else root.name)
+            sources.append("folder name")
+    return labels, sources, subjects
+
+
+def _load(folder, index_path, verbose):
+    """The loader's Bunch, with a one-line DemoDataError for anything that stops it."""
+    folder = Path(folder)
+    if not folder.exists():
+        raise DemoDataError(f"no folder at {folder}")
+    if not folder.is_dir():
+        raise DemoDataError(f"{folder} is a file, not a folder of motion files")
+    options = {"index": index_path}
+    if "verbose" in inspect.signature(load_motion_folder).parameters:
+        options["verbose"] = verbose  # progress of the loader, where it offers it
+    try:
+        return load_motion_folder(folder, **options)
+    except (OSError, ValueError) as exc:
+        message = " ".join(str(exc).split())
+        raise DemoDataError(f"{folder}: {message}") from None
 
 
 def to_rate(clip, frame_rate, target_rate):
@@ -21,16 +99,42 @@ def to_rate(clip, frame_rate, target_rate):
 
 
 def _unwrapped(motion):
-    """Channels with rotation angles unwrapped in time, so that interpolation never crosses a +-pi jump."""
+    """Channels with rotation angles unwrapped in time: interpolation never crosses a +-pi jump."""
     channels = motion.channels.copy()
     rotations = np.array([name.endswith("rotation") for name in motion.channel_names], dtype=bool)
     channels[:, rotations] = np.unwrap(channels[:, rotations], axis=0)
     return channels
 
 
+def _label_lines(sources, index_path):
+    counts = {k: sources.count(k) for k in ("CMU index", "file name", "folder name")}
+    index_text = f" ({index_path})" if index_path else " (none found in or above the folder)"
+    return [
+        f"labels: {counts['CMU index']} clips from the CMU index{index_text}, its descriptions "
+        "mapped to motion classes by keyword (skmotion.datasets.CMU_MOTION_CLASSES); "
+        f"{counts['file name']} from a keyword in the file name; {counts['folder name']} from the "
+        "folder name (fallback)"
+    ]
+
+
+def _figure_lines(context, motions, filenames, labels):
+    """Stick figures of the folder's first clip, at its own frame rate and skeleton."""
+    motion = motions[0]
+    what = f"{Path(filenames[0]).name} ({labels[0]})"
+    return body_figures(context, motion.channels, motion.skeleton, motion.frame_rate, what)
+
+
 def run(context):
     rate = float(getattr(context, "frame_rate", None) or 30.0)
-    data = load_motion_folder(context.data_folder)
+    verbose = getattr(context, "verbose", 0)
+    index_path = getattr(context, "index", None) or find_cmu_index(context.data_folder)
+    data = _load(context.data_folder, index_path, verbose)
+    index = read_cmu_index(index_path) if index_path else None
+    root = Path(context.data_folder).resolve()
+    files = [Path(f).resolve() for f in data.filenames]
+    labels, sources, subjects = label_clips(files, root, index)
+    target_names, target = np.unique(np.asarray(labels, dtype=object), return_inverse=True)
+    subject_names, groups = np.unique(np.asarray(subjects, dtype=object), return_inverse=True)
     motions = data.motions
     layouts = {tuple(m.channel_names) for m in motions}
     if len(layouts) == 1:
@@ -47,45 +151,51 @@ def run(context):
         skeleton = None
     context.data = Bunch(
         clips=clips,
-        target=data.target,
-        target_names=data.target_names,
-        groups=data.groups,
-        subject_names=data.subject_names,
+        target=target,
+        target_names=target_names,
+        groups=groups,
+        subject_names=subject_names,
         frame_rate=rate,
         motions=motions,
         skeletons=data.skeletons,
         skeleton=skeleton,
         feature_names=feature_names,
         filenames=data.filenames,
+        label_sources=sources,
         DESCR=data.DESCR,
     )
+    evaluation = choose_evaluation(
+        target_names[target], groups, subject_names, random_state=context.random_state
+    )
+    context.evaluation = evaluation
     lengths = np.array([len(c) for c in clips])
     rates = sorted({m.frame_rate for m in motions})
     n_bvh = sum(str(f).lower().endswith(".bvh") for f in data.filenames)
+    rate_text = ", ".join(f"{r:g}" for r in rates)
     lines = [
-        f"{context.data_folder}: {len(motions)} clips ({n_bvh} BVH, {len(motions) - n_bvh} ASF/AMC), "
-        f"{len({m.skeleton for m in motions})} skeletons, recorded at {', '.join(f'{r:g}' for r in rates)} Hz",
-        f"resampled to {rate:g} Hz: {lengths.sum():,} frames ({lengths.sum() / rate:.1f} s); clip length min "
-        f"{lengths.min()}, median {int(np.median(lengths))}, max {lengths.max()}",
+        f"{context.data_folder}: {len(motions)} clips ({n_bvh} BVH, {len(motions) - n_bvh} "
+        f"ASF/AMC), {len({m.skeleton for m in motions})} skeletons, recorded at {rate_text} Hz",
+        f"resampled to {rate:g} Hz: {lengths.sum():,} frames ({lengths.sum() / rate:.1f} s); "
+        f"clip length min {lengths.min()}, median {int(np.median(lengths))}, max {lengths.max()}",
         f"channels: {len(feature_names)} {kind}",
-        f"classes ({len(data.target_names)}): "
-        + ", ".join(f"{name} {n}" for name, n in zip(data.target_names, np.bincount(data.target))),
-        f"subjects ({len(data.subject_names)}): "
-        + ", ".join(f"{name} {n}" for name, n in zip(data.subject_names, np.bincount(data.groups))),
+        *_label_lines(sources, index_path),
+        f"classes ({len(target_names)}): "
+        + ", ".join(
+            f"{name} {n} ({len(np.unique(groups[target == k]))} subj.)"
+            for k, (name, n) in enumerate(zip(target_names, np.bincount(target)))
+        ),
+        f"subjects ({len(subject_names)}): "
+        + ", ".join(f"{name} {n}" for name, n in zip(subject_names, np.bincount(groups))),
+        f"evaluation: {evaluation.reason}",
     ]
-    n_groups = len(data.subject_names)
-    if n_groups >= 2:
-        baseline = make_pipeline(
-            ResampleClips(n_frames=32), FlattenClips(), KNeighborsClassifier(1)
-        )
-        scores = cross_val_score(
-            baseline, clips, data.target, groups=data.groups, cv=GroupKFold(min(n_groups, 5))
-        )
-        context.baseline_accuracy = scores.mean()
-        lines.append(
-            f"baseline, 1-NN on resampled clips, subject-wise {min(n_groups, 5)}-fold CV: "
-            f"accuracy {scores.mean():.3f} +/- {scores.std():.3f}"
-        )
-    else:
-        lines.append("one subject only: no subject-wise baseline")
-    return lines
+    if evaluation.kind is None:
+        lines.append("baseline: not run (no split can evaluate a classifier)")
+        return lines + _figure_lines(context, motions, data.filenames, target_names[target])
+    baseline = make_pipeline(ResampleClips(n_frames=32), FlattenClips(), KNeighborsClassifier(1))
+    scores = evaluation.scores(baseline, clips, target, verbose=verbose, desc="baseline CV")
+    context.baseline_accuracy = scores.mean()
+    lines.append(
+        f"baseline, 1-NN on resampled clips, {evaluation.name}: "
+        f"accuracy {scores.mean():.3f} +/- {scores.std():.3f}"
+    )
+    return lines + _figure_lines(context, motions, data.filenames, target_names[target])

@@ -1,13 +1,16 @@
-"""Demo section: virtual markers, one feature space for every skeleton (paper 000, III-A)."""
+"""Demo section: virtual markers, one feature space for every skeleton.
+
+The representation of Yamane, Yamaguchi and Nakamura (2011), section III-A.
+"""
 
 from collections import Counter
 
 import numpy as np
 from sklearn.linear_model import RidgeClassifier
-from sklearn.model_selection import GroupKFold, cross_val_score
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
+from skmotion._demo._split import evaluation_of
 from skmotion._demo.data_folder import to_rate
 from skmotion.io import as_motions
 from skmotion.preprocessing import (
@@ -44,21 +47,20 @@ def run(context):
         + ", ".join(f"{k} {v:.2f}" for k, v in height.items())
         + f"; median horizontal pelvis speed {speed:.2f} heights/s",
     ]
-    n_groups = len(np.unique(data.groups))
-    if n_groups >= 2 and len(np.unique(data.target)) >= 2:
-        cv = GroupKFold(min(n_groups, 5))
-        model = make_pipeline(
-            ResampleClips(n_frames=16), FlattenClips(), StandardScaler(), RidgeClassifier()
-        )
-        on_markers = cross_val_score(model, clips, data.target, groups=data.groups, cv=cv)
-        context.marker_accuracy = on_markers.mean()
-        lines.append(
-            f"ridge classifier on 16 resampled frames, subject-wise {cv.get_n_splits()}-fold CV: "
-            f"accuracy {on_markers.mean():.3f} +/- {on_markers.std():.3f} on markers"
-            + (
-                f" (raw-clip 1-NN baseline {context.baseline_accuracy:.3f})"
-                if hasattr(context, "baseline_accuracy")
-                else ""
-            )
-        )
+    evaluation = evaluation_of(context)
+    if evaluation.kind is None:
+        return lines + [f"ridge classifier on markers: not run ({evaluation.reason})"]
+    model = make_pipeline(
+        ResampleClips(n_frames=16), FlattenClips(), StandardScaler(), RidgeClassifier()
+    )
+    on_markers = evaluation.scores(
+        model, clips, data.target, verbose=getattr(context, "verbose", 0), desc="markers CV"
+    )
+    context.marker_accuracy = on_markers.mean()
+    baseline = getattr(context, "baseline_accuracy", None)
+    lines.append(
+        f"ridge classifier on 16 resampled frames, {evaluation.name}: "
+        f"accuracy {on_markers.mean():.3f} +/- {on_markers.std():.3f} on markers"
+        + (f" (raw-clip 1-NN baseline {baseline:.3f})" if baseline is not None else "")
+    )
     return lines

@@ -4,9 +4,9 @@ from importlib.util import find_spec
 
 import numpy as np
 from sklearn.linear_model import LogisticRegression
-from sklearn.model_selection import GroupKFold, cross_val_score
 from sklearn.pipeline import make_pipeline
 
+from skmotion._demo._split import evaluation_of
 from skmotion.control import ArmModel, KMeansPrimitiveController
 from skmotion.decomposition import EigenMovementPCA
 from skmotion.preprocessing import filter_min_frames, segment_clip
@@ -25,7 +25,7 @@ _MIN_MOVEMENT = 2.0  # degrees
 def _right_arm(data):
     """Channel indices of the right arm's 4 DOF and, when lengths are known, its ArmModel."""
     names = list(data.feature_names)
-    for upper, upper_axes, fore, fore_axis, end in _ARMS:
+    for upper, upper_axes, fore, fore_axis, end in _ARMS:  # noqa: B007 (used after break)
         wanted = [f"{upper}_{a}rotation" for a in upper_axes] + [f"{fore}_{fore_axis}rotation"]
         if all(w in names for w in wanted):
             break
@@ -42,22 +42,22 @@ def _classifier_lines(context, data):
     skeleton = data.get("skeleton")
     n_root = len(skeleton.channels[0]) if skeleton is not None else 0
     angles = [c[:, n_root:] for c in data.clips]  # without the root's travel and heading
-    n_groups = len(np.unique(data.groups))
-    if n_groups < 2 or len(angles) < 20:
-        return [
-            f"classifier on primitive usage: not run ({len(angles)} clips of {n_groups} subject(s))"
-        ]
+    evaluation = evaluation_of(context)
+    if evaluation.kind is None or len(evaluation.clips) < 20:
+        why = evaluation.reason if evaluation.kind is None else f"{len(evaluation.clips)} clips"
+        return [f"classifier on primitive usage: not run ({why}; it needs 20 clips or more)"]
     model = make_pipeline(
         EigenMovementPCA(10, n_samples=30, frame_rate=data.frame_rate),
         KMeansPrimitiveController(20, n_init=3, random_state=context.random_state),
         LogisticRegression(max_iter=2000),
     )
-    cv = GroupKFold(n_groups)
-    scores = cross_val_score(model, angles, data.target, groups=data.groups, cv=cv)
+    scores = evaluation.scores(
+        model, angles, data.target, verbose=getattr(context, "verbose", 0), desc="primitives CV"
+    )
     context.primitive_accuracy = scores.mean()
     return [
-        "classifier on primitive usage (joint angles, EigenMovementPCA -> KMeansPrimitiveController "
-        f"-> LogisticRegression), subject-wise {cv.n_splits}-fold CV: accuracy "
+        "classifier on primitive usage (joint angles, EigenMovementPCA -> "
+        f"KMeansPrimitiveController -> LogisticRegression), {evaluation.name}: accuracy "
         f"{scores.mean():.3f} +/- {scores.std():.3f}"
     ]
 
@@ -93,7 +93,8 @@ def run(context):
     idx, arm = _right_arm(data)
     if idx is None:
         return [
-            "not run: no right arm (RightArm/RightForeArm or rhumerus/rradius rotations) in the channels"
+            "not run: no right arm (RightArm/RightForeArm or rhumerus/rradius rotations) in "
+            "the channels"
         ]
     clips = [np.degrees(c[:, idx]) for c in data.clips]  # the paper's 4 DOF, in degrees
     names = [data.feature_names[i] for i in idx]
@@ -117,8 +118,9 @@ def run(context):
     n_features = pca.components_.shape[1]
     total = pca.projection_mse_ + controller.clustering_mse_
     lines = [
-        f"right arm ({', '.join(names)}), degrees: energy segmentation (SEG-2) of {len(clips)} clips "
-        f"gives {pca.n_segments_} segments, {pca.n_segments_ / len(clips):.1f} per clip"
+        f"right arm ({', '.join(names)}), degrees: energy segmentation (SEG-2) of "
+        f"{len(clips)} clips gives {pca.n_segments_} segments, "
+        f"{pca.n_segments_ / len(clips):.1f} per clip"
         + ("" if order else " (clips too short for the order-10 low-pass: not filtered)"),
         f"{pca.n_components_} eigenmovements of {n_features} samples keep "
         f"{100 * pca.explained_variance_ratio_.sum():.2f}% of the variance; projection RMS "

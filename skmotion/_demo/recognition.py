@@ -3,37 +3,11 @@
 import numpy as np
 
 from skmotion._demo._figures import save_figure
+from skmotion._demo._split import confusion_lines, evaluation_of
 from skmotion.tree import MotionTreeHMM
+from skmotion.utils import say
 
 TITLE = "Recognition: the motion database (MotionTreeHMM)"
-
-
-def _confusion(names, truth, predicted):
-    width = max(len(n) for n in names)
-    lines = [
-        "confusion (rows: true, columns: predicted):",
-        " " * (width + 2) + " ".join(n[:5].rjust(5) for n in names),
-    ]
-    for name in names:
-        row = [int(np.sum((truth == name) & (predicted == other))) for other in names]
-        lines.append(f"  {name.rjust(width)} " + " ".join(str(v).rjust(5) for v in row))
-    return lines
-
-
-def _split(data, names):
-    """Train and test clips: the last subject held out, or every third clip of each class with one subject."""
-    groups = np.asarray(data.groups)
-    if len(np.unique(groups)) >= 2:
-        held_out = groups.max()
-        name = data.get("subject_names")
-        label = f"subject {name[held_out] if name is not None else held_out}"
-        return np.flatnonzero(groups != held_out), np.flatnonzero(groups == held_out), label
-    rank = np.zeros(len(names), dtype=int)
-    for value in np.unique(names):
-        members = np.flatnonzero(names == value)
-        rank[members] = np.arange(len(members))
-    test = rank % 3 == 2
-    return np.flatnonzero(~test), np.flatnonzero(test), "every third clip of each class"
 
 
 def run(context):
@@ -42,11 +16,11 @@ def run(context):
     # root's travel and heading removed, which say where a subject walked, not how it moved.
     clips = context.marker_clips
     names = np.asarray(data.target_names)[data.target]
-    train, test, held_out = _split(data, names)
-    if len(np.unique(names[train])) < 2 or len(test) == 0:
-        return [
-            f"{len(clips)} clips in {len(np.unique(names))} classes: too few to train and test a classifier"
-        ]
+    evaluation = evaluation_of(context)
+    if evaluation.kind is None:
+        return [f"not run: {evaluation.reason}"]
+    train, test, held_out = evaluation.holdout(names)
+    say(getattr(context, "verbose", 0), f"demo: fitting MotionTreeHMM on {len(train)} clips ...")
     model = MotionTreeHMM().fit([clips[i] for i in train], names[train])
     context.motion_tree = model
     predicted = model.predict([clips[i] for i in test])
@@ -59,29 +33,22 @@ def run(context):
     n_markers = clip.shape[1] // 6
     lines = [
         f"MotionTreeHMM (defaults: minimum-error splits, max_depth={model.max_depth}, "
-        f"min_samples_leaf={model.min_samples_leaf}) on {n_markers} virtual markers ({clip.shape[1]} channels)",
-        f"trained on {len(train)} clips, tested on {held_out} ({len(test)} clips): accuracy {accuracy:.3f}",
-        *_confusion(
-            [str(c) for c in model.classes_], names[test].astype(str), predicted.astype(str)
-        ),
+        f"min_samples_leaf={model.min_samples_leaf}) on {n_markers} virtual markers "
+        f"({clip.shape[1]} channels)",
+        f"trained on {len(train)} clips, tested on {held_out} ({len(test)} clips): "
+        f"accuracy {accuracy:.3f}",
+        *confusion_lines(names[test], predicted),
         f"tree: {int(tree.count[0]):,} frames, {tree.n_layers} layers, {tree.n_tree_nodes} nodes, "
         f"{int(tree.n_nodes[-1])} in the bottom layer",
         "nodes per layer: " + " ".join(str(int(n)) for n in tree.n_nodes),
-        f"state estimation, first {half_second} frames of a test {names[test[0]]}: bottom-layer nodes "
-        + " ".join(str(int(n)) for n in states[-6:])
-        + " (last six)",
-        f"prediction 5 frames ahead: node {int(ahead.nodes[0, 0])} with probability {ahead.probabilities[0, 0]:.2f}",
+        f"state estimation, first {half_second} frames of a test {names[test[0]]}: "
+        "bottom-layer nodes " + " ".join(str(int(n)) for n in states[-6:]) + " (last six)",
+        f"prediction 5 frames ahead: node {int(ahead.nodes[0, 0])} with probability "
+        f"{ahead.probabilities[0, 0]:.2f}",
     ]
-    plot_dir = getattr(context, "plot_dir", None)
-    if plot_dir:
-        lines += save_figure(
-            plot_dir,
-            "motion_tree_layers.png",
-            lambda plotting: plotting.plot_motion_tree_layers(model.tree_, model.global_graph_),
-            "nodes on the first principal axes with the global transition graph",
-        )
-    else:
-        lines.append(
-            "(skmotion demo --plots DIR draws the tree's nodes and transition graphs, as the paper's Figures 3-5)"
-        )
-    return lines
+    return lines + save_figure(
+        context,
+        "motion_tree_layers.png",
+        lambda plotting: plotting.plot_motion_tree_layers(model.tree_, model.global_graph_),
+        "nodes on the first principal axes with the global transition graph",
+    )

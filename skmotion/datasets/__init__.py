@@ -1,5 +1,6 @@
 """Datasets: the built-in synthetic motions and humanoid skeleton; loaders of real data."""
 
+from skmotion.datasets._cmu_labels import CMU_MOTION_CLASSES, cmu_motion_class, motion_class_of_name
 from skmotion.datasets._fetch import fetch_cmu_mocap
 from skmotion.datasets._home import get_data_home
 from skmotion.datasets._humanoid import humanoid_skeleton
@@ -21,9 +22,11 @@ from skmotion.datasets._uea import load_uea
 from skmotion.datasets._walks import WALK_DIRECTIONS, make_walks
 
 __all__ = [
+    "CMU_MOTION_CLASSES",
     "EXTRA_LANDMARKS",
     "MOTION_CLASSES",
     "WALK_DIRECTIONS",
+    "cmu_motion_class",
     "fetch_cmu_mocap",
     "get_data_home",
     "humanoid_skeleton",
@@ -37,5 +40,6 @@ __all__ = [
     "make_position_motions",
     "make_repeated_motions",
     "make_walks",
+    "motion_class_of_name",
     "read_cmu_index",
 ]

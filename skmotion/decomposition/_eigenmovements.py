@@ -1,16 +1,20 @@
 """EigenMovementPCA: PCA of segmented movement (eigenmovements)."""
 
+import time
 from numbers import Integral, Real
 
 import numpy as np
-from sklearn.base import BaseEstimator, TransformerMixin
+from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
-from skmotion.base import ClipEstimatorMixin, MotionTags
+from skmotion.base import ClipEstimatorMixin, MotionTags, _OutputConfigMixin
 from skmotion.decomposition._principal_axes import principal_axes
 from skmotion.decomposition._segment_vectors import (
+    SegmentCodes,
     assemble_segments,
+    check_magnitude,
     check_segments,
+    codes_frame,
     frame_counts,
     retime_segments,
     segment_vectors,
@@ -20,14 +24,17 @@ from skmotion.preprocessing._filter import filter_min_frames
 from skmotion.preprocessing._segment import segment_clip
 from skmotion.utils._clips import check_clips, to_container
 from skmotion.utils._parallel import parallel_map
+from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["EigenMovementPCA"]
 
+# Inputs up to this magnitude are handled exactly as at unit scale (they are divided by a
+# power of two inside); beyond it the variances, in squared input units, overflow float64.
+_MAX_MAGNITUDE = 1e150
 
-class EigenMovementPCA(
-    ClipEstimatorMixin, TransformerMixin, BaseEstimator, auto_wrap_output_keys=None
-):
+
+class EigenMovementPCA(ClipEstimatorMixin, _OutputConfigMixin, BaseEstimator):
     """Eigenmovements: PCA of movement segments, each coded by a few numbers.
 
     Each clip is cut into segments (strokes from rest to rest), each segment is
@@ -75,6 +82,9 @@ class EigenMovementPCA(
         prominence.
     n_jobs : int, default=None
         Jobs over clips for segmenting and resampling (``None`` is serial).
+    verbose : int, default=0
+        1 reports the steps of ``fit`` (segmenting, PCA) and their times on
+        standard error.
 
     Attributes
     ----------
@@ -119,6 +129,20 @@ class EigenMovementPCA(
     ``(start, stop)`` frames. Errors are in the input's units: feed joint
     angles in degrees to get the paper's degrees.
 
+    In a pipeline, the codes are a collection of sequences (one per clip), as
+    clips are, so a step taking clips follows: :class:`KMeansPrimitiveController`
+    turns them into one usage histogram per clip, for any classifier after it.
+    ``make_pipeline(EigenMovementPCA(5), LogisticRegression())`` fails with a
+    TypeError saying so (the codes refuse to become one table: see
+    :class:`SegmentCodes`). With ``set_output(transform="pandas")`` the codes are
+    one DataFrame with a ``(clip, segment)`` MultiIndex and the columns
+    ``get_feature_names_out()``; a clip without segments has no rows there.
+
+    The results scale with the input: clips multiplied by ``a`` give the same
+    eigenmovements and segments, codes and ``mean_`` times ``a``, variances times
+    ``a**2`` (inputs are divided by a power of two inside, so no square overflows).
+    Clips beyond 1e150 in magnitude are refused: their variances exceed float64.
+
     References
     ----------
     .. [1] Fod, Mataric and Jenkins, "Automated derivation of primitives for
@@ -155,6 +179,7 @@ class EigenMovementPCA(
         "zvc_min_channels": [Interval(Integral, 1, None, closed="left")],
         "min_movement": [Interval(Real, 0, None, closed="left")],
         "n_jobs": [Integral, None],
+        "verbose": ["verbose"],
     }
 
     def __init__(
@@ -172,6 +197,7 @@ class EigenMovementPCA(
         zvc_min_channels=2,
         min_movement=0.0,
         n_jobs=None,
+        verbose=0,
     ):
         self.n_components = n_components
         self.n_samples = n_samples
@@ -185,6 +211,7 @@ class EigenMovementPCA(
         self.zvc_min_channels = zvc_min_channels
         self.min_movement = min_movement
         self.n_jobs = n_jobs
+        self.verbose = verbose
 
     def __skmotion_tags__(self):
         return MotionTags(output_kind="segments", min_frames=self._min_frames())
@@ -197,20 +224,33 @@ class EigenMovementPCA(
     # -- segmentation and vectors ---------------------------------------------------
 
     def _segments_of(self, clip):
+        """Segments of a clip already divided by ``self._scale`` (absolute thresholds too)."""
         if self.segmentation == "none":
             return np.array([[0, len(clip)]], dtype=np.intp)
+        scale = self._scale
+        threshold = self.energy_threshold
         return segment_clip(
             clip,
             rule=self.segmentation,
             frame_rate=self.frame_rate,
             filter_order=self.filter_order,
             filter_cutoff=self.filter_cutoff,
-            energy_threshold=self.energy_threshold,
+            energy_threshold=None if threshold is None else threshold / scale**2,
             energy_ratio=self.energy_ratio,
             zvc_window=self.zvc_window,
             zvc_min_channels=self.zvc_min_channels,
-            min_movement=self.min_movement,
+            min_movement=self.min_movement / scale,
         )
+
+    def _normalised(self, clips, reset=False):
+        """The clips divided by a power of two (exact), so that no square overflows.
+
+        ``reset`` chooses the power from the training clips' largest magnitude.
+        """
+        peak = check_magnitude(clips, _MAX_MAGNITUDE, "EigenMovementPCA")
+        if reset:
+            self._scale = float(2.0 ** np.floor(np.log2(peak))) if peak > 0 else 1.0
+        return [c / self._scale for c in clips]
 
     def _segment_all(self, clips):
         return parallel_map(self._segments_of, clips, n_jobs=self.n_jobs)
@@ -219,17 +259,28 @@ class EigenMovementPCA(
         return segment_vectors(clips, segments, self.n_samples)
 
     def _encode(self, vectors):
-        return (vectors - self.mean_) @ self.components_.T
+        """Codes, in input units, of segment vectors of normalised clips."""
+        scale = self._scale
+        return ((vectors - self.mean_ / scale) @ self.components_.T) * scale
 
     def _decode(self, codes):
         return codes @ self.components_ + self.mean_
+
+    def _wrap_codes(self, codes, clips):
+        """The codes as a SegmentCodes list or, with pandas output, a (clip, segment) DataFrame."""
+        if self._output_config() != "pandas":
+            return SegmentCodes(codes)
+        return codes_frame(codes, clips.container, self.get_feature_names_out())
 
     # -- fitting -----------------------------------------------------------------------
 
     def _fit(self, X):
         clips = check_clips(X, estimator=self, reset=True)
-        segments = self._segment_all(clips)
-        per_clip = self._vectors_all(clips, segments)
+        start = time.perf_counter()
+        normalised = self._normalised(clips, reset=True)
+        say(self.verbose, f"EigenMovementPCA: segmenting {len(clips)} clips ...")
+        segments = self._segment_all(normalised)
+        per_clip = self._vectors_all(normalised, segments)
         vectors = np.concatenate(per_clip)
         n_segments, n_features = vectors.shape
         if n_segments == 0:
@@ -245,22 +296,24 @@ class EigenMovementPCA(
                 f"min({n_segments}, {n_features}) = {limit}: the {len(clips)} training clips "
                 f"gave {n_segments} segments."
             )
+        say(self.verbose, f"EigenMovementPCA: PCA of {n_segments} segments x {n_features} ...")
         mean, axes, eigenvalues = principal_axes(vectors, n_components)
-        self.mean_ = mean
+        scale, squared = self._scale, self._scale**2
+        total = float(np.einsum("ij,ij->", vectors - mean, vectors - mean) / n_segments)
+        self.mean_ = mean * scale
         self.components_ = axes
-        self.explained_variance_ = eigenvalues[:n_components]
-        self.total_variance_ = float(
-            np.einsum("ij,ij->", vectors - mean, vectors - mean) / n_segments
-        )
-        total = self.total_variance_
+        self.explained_variance_ = eigenvalues[:n_components] * squared
+        self.total_variance_ = total * squared
         self.explained_variance_ratio_ = (
-            self.explained_variance_ / total if total > 0 else np.zeros(n_components)
+            eigenvalues[:n_components] / total if total > 0 else np.zeros(n_components)
         )
-        self.projection_mse_ = float(eigenvalues[n_components:].sum())
-        self.projection_rms_ = float(np.sqrt(self.projection_mse_ / n_features))
+        dropped = float(eigenvalues[n_components:].sum())
+        self.projection_mse_ = dropped * squared
+        self.projection_rms_ = float(np.sqrt(dropped / n_features)) * scale
         self.n_components_ = n_components
         self.n_segments_ = n_segments
-        return per_clip
+        say(self.verbose, f"EigenMovementPCA: fitted in {time.perf_counter() - start:.1f} s")
+        return per_clip, clips
 
     @_fit_context(prefer_skip_nested_validation=True)
     def fit(self, X, y=None):
@@ -294,10 +347,11 @@ class EigenMovementPCA(
 
         Returns
         -------
-        codes : list of ndarray of shape (n_segments_i, n_components_)
-            One array per clip.
+        codes : SegmentCodes (a list) of ndarray of shape (n_segments_i, n_components_)
+            One array per clip; a (clip, segment) DataFrame with pandas output.
         """
-        return [self._encode(v) for v in self._fit(X)]
+        per_clip, clips = self._fit(X)
+        return self._wrap_codes([self._encode(v) for v in per_clip], clips)
 
     # -- per-clip queries ----------------------------------------------------------
 
@@ -317,7 +371,7 @@ class EigenMovementPCA(
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
-        return self._segment_all(clips)
+        return self._segment_all(self._normalised(clips))
 
     def segment_vectors(self, X):
         """The segments of each clip, resampled and flattened (what PCA sees).
@@ -333,8 +387,9 @@ class EigenMovementPCA(
             Per clip, one row per segment, channel after channel.
         """
         check_is_fitted(self)
-        clips = check_clips(X, estimator=self)
-        return self._vectors_all(clips, self._segment_all(clips))
+        normalised = self._normalised(check_clips(X, estimator=self))
+        vectors = self._vectors_all(normalised, self._segment_all(normalised))
+        return [v * self._scale for v in vectors]
 
     def transform(self, X):
         """Code each segment of each clip by its eigenmovement coordinates.
@@ -346,12 +401,41 @@ class EigenMovementPCA(
 
         Returns
         -------
-        codes : list of ndarray of shape (n_segments_i, n_components_)
-            One array per clip, a row per segment (see :meth:`segment`).
+        codes : SegmentCodes (a list) of ndarray of shape (n_segments_i, n_components_)
+            One array per clip, a row per segment (see :meth:`segment`); with
+            ``set_output(transform="pandas")`` one DataFrame indexed by (clip, segment).
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
-        return [self._encode(v) for v in self._vectors_all(clips, self._segment_all(clips))]
+        normalised = self._normalised(clips)
+        vectors = self._vectors_all(normalised, self._segment_all(normalised))
+        return self._wrap_codes([self._encode(v) for v in vectors], clips)
+
+    def get_feature_names_out(self, input_features=None):
+        """Names of the code columns: ``eigenmovementpca0``, ``eigenmovementpca1``, ...
+
+        Parameters
+        ----------
+        input_features : array-like of str, default=None
+            Ignored beyond a check against ``feature_names_in_`` (a code mixes
+            every channel).
+
+        Returns
+        -------
+        names : ndarray of str of shape (n_components_,)
+        """
+        check_is_fitted(self)
+        if input_features is not None:
+            expected = getattr(self, "feature_names_in_", None)
+            given = np.asarray(input_features, dtype=object)
+            if len(given) != self.n_features_in_ or (
+                expected is not None and not np.array_equal(given, expected)
+            ):
+                raise ValueError(
+                    f"input_features {list(given)} do not match the {self.n_features_in_} "
+                    "channels seen in fit."
+                )
+        return np.asarray([f"eigenmovementpca{i}" for i in range(self.n_components_)], dtype=object)
 
     def inverse_transform(self, codes, segments=None, n_frames=None):
         """Movement from codes: time-normalised segments, or clips re-timed.
@@ -397,9 +481,10 @@ class EigenMovementPCA(
         return assemble_segments(pieces, segments, n_frames, self.n_features_in_)
 
     def _reconstruct(self, clips):
-        segments = self._segment_all(clips)
+        normalised = self._normalised(clips)
+        segments = self._segment_all(normalised)
         rebuilt = []
-        for clip, seg, vectors in zip(clips, segments, self._vectors_all(clips, segments)):
+        for clip, seg, vectors in zip(clips, segments, self._vectors_all(normalised, segments)):
             projected = vectors_to_segments(
                 self._decode(self._encode(vectors)), self.n_features_in_
             )
@@ -449,4 +534,5 @@ class EigenMovementPCA(
             raise ValueError(
                 f"No segments were found in the {len(clips)} clips of X: nothing to score."
             )
-        return -float(np.sqrt(np.mean(diff[covered] ** 2)))
+        scaled = diff[covered] / self._scale  # no square underflows or overflows
+        return -float(np.sqrt(np.mean(scaled**2))) * self._scale

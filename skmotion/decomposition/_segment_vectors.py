@@ -10,6 +10,7 @@ resampled together, as the columns of one array, by
 """
 
 import numpy as np
+import pandas as pd
 
 from skmotion.preprocessing._resample import resample_clip
 
@@ -58,7 +59,7 @@ def segment_vectors(clips, segments, n_samples):
     owner = np.repeat(np.arange(len(clips)), [len(s) for s in segments])
     pairs = np.concatenate([s.reshape(-1, 2) for s in segments]).astype(np.intp)
     out = np.empty((len(pairs), n_channels * n_samples))
-    for length, rows in _by_length(pairs[:, 1] - pairs[:, 0]):
+    for _length, rows in _by_length(pairs[:, 1] - pairs[:, 0]):
         pieces = np.stack([clips[owner[r]][pairs[r, 0] : pairs[r, 1]] for r in rows], axis=1)
         samples = _stretch(
             pieces.astype(float, copy=False), n_samples
@@ -182,12 +183,71 @@ def frame_counts(n_frames, segments):
         counts = np.full(len(segments), counts)
     if counts.shape != (len(segments),) or counts.dtype.kind not in "iu":
         raise ValueError(
-            f"n_frames must be an int or one int per clip ({len(segments)} clips); got {n_frames!r}."
+            f"n_frames must be an int or one int per clip ({len(segments)} clips); "
+            f"got {n_frames!r}."
         )
     short = np.flatnonzero(counts < ends)
     if short.size:
         i = short[0]
         raise ValueError(
-            f"n_frames: clip {i} is given {counts[i]} frames but its segments reach frame {ends[i]}."
+            f"n_frames: clip {i} is given {counts[i]} frames but its segments reach "
+            f"frame {ends[i]}."
         )
     return [int(n) for n in counts]
+
+
+class SegmentCodes(list):
+    """Codes of ``EigenMovementPCA.transform``: an ``(n_segments_i, n_components)`` array per clip.
+
+    A list that refuses to become one table: clips differ in their number of segments,
+    so an estimator that needs one row per clip (``LogisticRegression``, say) cannot
+    take it directly. Turning it into an array raises a TypeError that says what to
+    put in between.
+    """
+
+    def __array__(self, dtype=None, copy=None):
+        raise TypeError(
+            "EigenMovementPCA returns one array of segment codes per clip (clips differ in "
+            "their number of segments), not a table with one row per clip. Put a step that "
+            "makes one row per clip between it and a table estimator: "
+            "KMeansPrimitiveController (each clip's usage histogram of primitives), or "
+            "ResampleClips(n_frames=k) then FlattenClips() (each code sequence resampled to k "
+            "steps); "
+            "np.concatenate(codes) gives one row per segment."
+        )
+
+
+def codes_frame(codes, container, columns):
+    """Per-clip code arrays as one DataFrame indexed by (clip, segment).
+
+    Every clip must have a segment: a clip without rows would vanish from the frame.
+    """
+    counts = np.array([len(c) for c in codes])
+    if (counts == 0).any():
+        k = int(np.flatnonzero(counts == 0)[0])
+        raise ValueError(
+            f"X: clip {k} has no segments, and a (clip, segment) DataFrame cannot hold a "
+            "clip without rows; use the default output (a list) to keep every clip."
+        )
+    labels = container.clip_labels
+    labels = np.arange(len(codes)) if labels is None else np.asarray(labels, dtype=object)
+    names = container.index_names
+    index = pd.MultiIndex.from_arrays(
+        [np.repeat(labels, counts), np.concatenate([np.arange(n) for n in counts])],
+        names=[names[0] if names else "clip", "segment"],
+    )
+    return pd.DataFrame(np.concatenate(codes), index=index, columns=columns)
+
+
+def check_magnitude(clips, limit, owner):
+    """The largest magnitude of the clips; a ValueError naming the clip beyond ``limit``."""
+    peaks = np.array([np.max(np.abs(c)) if c.size else 0.0 for c in clips])
+    too_big = np.flatnonzero(peaks > limit)
+    if len(too_big):
+        k = int(too_big[0])
+        raise ValueError(
+            f"X: clip {k} reaches {peaks[k]:.3g} in magnitude; {owner}'s variances (squared "
+            f"input units) exceed float64's range beyond {limit:g}. Rescale the clips "
+            "(degrees, radians, metres)."
+        )
+    return float(peaks.max(initial=0.0))

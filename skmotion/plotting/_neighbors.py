@@ -8,7 +8,7 @@ __all__ = ["plot_pruning_recall"]
 def plot_pruning_recall(rows, *, n_levels=7):
     """Pruning efficiency and recall against ``epsilon``, one panel per dataset.
 
-    The paper's Figures 9-11 from a results table such as
+    Li and Prabhakaran's (2006) Figures 9-11 from a results table such as
     ``benchmarks/bench_neighbors_pruning.py`` writes.
 
     Parameters

@@ -14,7 +14,7 @@ def plot_eigenmovements(
     """The first eigenmovements, one row each, one panel per channel.
 
     Each panel shows how one channel moves over the normalised time of a
-    segment in one eigenmovement (the eigenmovement paper's Fig. 7). The panels
+    segment in one eigenmovement (Fod, Mataric and Jenkins 2002, Fig. 7). The panels
     of a row share their vertical scale, so a channel's share of the
     eigenmovement shows.
 
@@ -79,8 +79,8 @@ def plot_eigenmovements(
     for i in range(rows):
         for k, c in enumerate(channels):
             ax = axes[i, k]
-            ax.plot(time, movements[i, c], color="C0")
-            ax.axhline(0.0, color="0.8", linewidth=0.8)
+            (curve,) = ax.plot(time, movements[i, c], color="C0", label="eigenmovement")
+            zero = ax.axhline(0.0, color="0.8", linewidth=0.8, label="zero")
             if i == 0:
                 ax.set_title(channel_names[k], fontsize=9)
             if k == 0:
@@ -88,5 +88,13 @@ def plot_eigenmovements(
             if i == rows - 1:
                 ax.set_xlabel("normalised time", fontsize=8)
             ax.tick_params(labelsize=7)
-    figure.tight_layout()
+    figure.tight_layout(rect=(0, 0, 1, 0.93))
+    # One legend for every panel: the curve is the channel's course over a segment.
+    figure.legend(
+        handles=[curve, zero],
+        labels=["the channel's course in the eigenmovement (a unit vector)", "zero"],
+        loc="upper center",
+        ncol=2,
+        fontsize=8,
+    )
     return figure

@@ -8,7 +8,7 @@ __all__ = ["plot_motion_tree_layer", "plot_motion_tree_layers", "plot_motion_tre
 
 
 def _node_spread(tree, layer):
-    """Largest standard deviation of each node (the paper sizes nodes by their largest singular value)."""
+    """Largest standard deviation of each node (Yamane et al. size nodes by it)."""
     cov = tree.covariances(layer)
     if tree.covariance_type == "full":
         return np.sqrt(np.linalg.eigvalsh(cov)[:, -1])
@@ -18,7 +18,7 @@ def _node_spread(tree, layer):
 
 
 def _edges(graphs, layer, graph, min_probability):
-    """Transitions between different nodes seen in the graph, with probability at least the threshold."""
+    """Transitions between different nodes seen in the graph, with probability >= the threshold."""
     counts = graphs.counts(layer, graph).tocoo()
     totals = graphs.row_totals(layer)[graph]
     prob = (counts.data + graphs.pseudo_count(layer)) / (totals[counts.row] + graphs.smoothing)
@@ -29,7 +29,9 @@ def _edges(graphs, layer, graph, min_probability):
 def plot_motion_tree_layer(
     tree, graphs=None, layer=-1, *, graph=0, axes=(0, 1), min_probability=0.05, ax=None
 ):
-    """The nodes of one layer on the first principal axes, with a transition graph (the paper's Figures 3-5).
+    """The nodes of one layer on the first principal axes, with a transition graph.
+
+    The figures 3-5 of Yamane, Yamaguchi and Nakamura (2011).
 
     Each node is drawn at its mean frame projected on principal axes of all
     frames (``tree.principal_axes``), with an area that grows with its frame
@@ -89,16 +91,32 @@ def plot_motion_tree_layer(
                 zorder=1,
             )
     counts = tree.counts(layer)
-    ax.scatter(
+    spread = np.maximum(_node_spread(tree, layer), 1e-12)
+    wide = spread.max() > 10 * spread.min()
+    nodes = ax.scatter(
         xy[:, 0],
         xy[:, 1],
         s=20 + 200 * counts / counts.max(),
-        c=_node_spread(tree, layer),
-        cmap="Blues",
+        c=spread,
+        cmap="viridis",
+        # Spreads span orders of magnitude (a few wide nodes); a log scale keeps the rest apart.
+        norm=plt.matplotlib.colors.LogNorm(spread.min(), spread.max()) if wide else None,
         edgecolors="k",
         linewidths=0.4,
         zorder=2,
     )
+    ax.figure.colorbar(nodes, ax=ax, label="node spread (largest std)" + (", log" if wide else ""))
+    from matplotlib.lines import Line2D
+
+    handles = [
+        Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=4, label="node, small: few frames"),
+        Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=11, label="node, large: many"),
+    ]
+    if graphs is not None:
+        handles.append(
+            Line2D([], [], color="tab:red", lw=0.8, label=f"transition, p >= {min_probability:g}")
+        )
+    ax.legend(handles=handles, loc="best", fontsize="x-small")
     ax.set_xlabel(f"principal axis {axes[0] + 1}")
     ax.set_ylabel(f"principal axis {axes[1] + 1}")
     ax.set_title(f"layer {layer}: {len(counts)} nodes")
@@ -108,7 +126,7 @@ def plot_motion_tree_layer(
 def plot_motion_tree_layers(
     tree, graphs=None, layers=None, *, graph=0, axes=(0, 1), min_probability=0.05
 ):
-    """Several layers side by side (the paper's Figure 5 shows layers 4 and 7).
+    """Several layers side by side (Yamane et al. 2011, Figure 5, show layers 4 and 7).
 
     Parameters
     ----------
@@ -134,14 +152,14 @@ def plot_motion_tree_layers(
     >>> from skmotion.tree import MotionTreeHMM
     >>> data = make_motions(n_clips_per_class=2, classes=["walk", "jump"], random_state=0)
     >>> model = MotionTreeHMM(max_depth=4).fit([c[:, 6:] for c in data.clips], data.target)
-    >>> len(plot_motion_tree_layers(model.tree_, model.global_graph_).axes)
-    3
+    >>> len(plot_motion_tree_layers(model.tree_, model.global_graph_).axes)  # panels, colour bars
+    6
     """
     plt = _pyplot()
     if layers is None:
         bottom = tree.n_layers - 1
         layers = sorted({max(1, bottom // 3), max(1, 2 * bottom // 3), bottom})
-    fig, panels = plt.subplots(1, len(layers), figsize=(4.5 * len(layers), 4), squeeze=False)
+    fig, panels = plt.subplots(1, len(layers), figsize=(5.5 * len(layers), 4.2), squeeze=False)
     for ax, layer in zip(panels[0], layers):
         plot_motion_tree_layer(
             tree, graphs, layer, graph=graph, axes=axes, min_probability=min_probability, ax=ax
@@ -151,7 +169,7 @@ def plot_motion_tree_layers(
 
 
 def plot_motion_tree_profile(profile, classes, *, step=1, frame_rate=None, ax=None):
-    """Class probabilities of sliding windows over one clip (the paper's Figures 10-12).
+    """Class probabilities of sliding windows over one clip (Yamane et al. 2011, Figs. 10-12).
 
     Parameters
     ----------
