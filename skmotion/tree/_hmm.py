@@ -762,7 +762,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
         return partial_fit(self, X, y, classes, split_growth, rebuild_tol)
 
-    def stream(self, *, layer=None, lag=0, window=None, n_best=3):
+    def stream(self, *, layer=None, lag=0, window=None, n_best=3, mode="exact", beam=None):
         """An online decoder: recognition and state estimation as frames arrive.
 
         ``stream.update(frames)`` takes one frame or a chunk and returns the
@@ -787,10 +787,19 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             cost per update), or all frames so far (None).
         n_best : int, default=3
             Predicted next nodes per update.
+        mode : {"exact", "online"}, default="exact"
+            ``"exact"``: the batch answers of the frames so far, decoded again
+            at each update (:class:`~skmotion.tree._stream.MotionStream`).
+            ``"online"``: a causal top-down beam kept between calls, a bounded
+            cost per frame (forward scores only, so its answers may differ
+            from the batch ones; :class:`~skmotion.tree._online_stream.OnlineMotionStream`).
+        beam : int, default=None
+            ``mode="online"`` only: nodes kept per frame and layer (the
+            model's ``n_paths`` by default).
 
         Returns
         -------
-        stream : MotionStream
+        stream : MotionStream or OnlineMotionStream
 
         Examples
         --------
@@ -808,9 +817,19 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         >>> bool((stream.path() == model.decode(X[:1])[0]).all())
         True
         """
+        check_is_fitted(self)
+        if mode == "online":
+            from skmotion.tree._online_stream import OnlineMotionStream
+
+            if window is not None:
+                raise ValueError("window is for mode='exact'; the online stream is causal.")
+            return OnlineMotionStream(self, layer=layer, lag=lag, beam=beam, n_best=n_best)
+        if mode != "exact":
+            raise ValueError(f"mode must be 'exact' or 'online'; got {mode!r}.")
+        if beam is not None:
+            raise ValueError("beam is for mode='online'; the exact stream uses n_paths.")
         from skmotion.tree._stream import MotionStream
 
-        check_is_fitted(self)
         return MotionStream(self, layer=layer, lag=lag, window=window, n_best=n_best)
 
     def sample(
