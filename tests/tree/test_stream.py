@@ -1,12 +1,15 @@
 """MotionStream: fed frame by frame or in chunks, the batch answers exactly."""
 
+import pickle
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skmotion.datasets import make_motions
-from skmotion.tree import MotionTreeHMM
+from skmotion.tree import MotionTreeHMM, exhaustive_viterbi
+from skmotion.tree._decode import _log_normaliser
 
 
 def _data():
@@ -139,11 +142,6 @@ def test_a_stream_refuses_a_model_fit_again():
 
 
 # -- mode="online": the causal beam ------------------------------------------------------
-
-import pickle  # noqa: E402
-
-from skmotion.tree import exhaustive_viterbi  # noqa: E402
-from skmotion.tree._decode import _log_normaliser  # noqa: E402
 
 SMALL = {
     "class, layer prior": MotionTreeHMM(max_depth=3, min_samples_leaf=8).fit(CLIPS, LABELS),
