@@ -16,9 +16,16 @@ Result tables, all measured in one run:
   out) and CMU subject 02 in 1 s windows of virtual markers (split by time
   inside each trial, as in ``bench_tree.py``).
 - ``live_stream_cost``: microseconds per frame of ``stream().update`` on a clip
-  of 32 virtual markers (192 channels), against the chunk size and the window,
-  and the ratio to the batch ``predict`` + ``decode`` of the same frames (timed
-  in alternation).
+  of 32 virtual markers (192 channels), for the exact stream (window of 30
+  frames, or all frames) and the online one, against the chunk size; the ratio
+  to the batch ``predict`` + ``decode`` of the same frames (timed in
+  alternation) and to the exact stream with a 30-frame window.
+- ``live_online_agreement``: the online (causal) stream against the batch
+  answers, per data set: the share of frames whose current node (and node
+  ``lag`` = 5 frames back) equals the batch ``decode`` of the whole clip at the
+  bottom layer, the share of clips whose final label equals the batch
+  ``predict``, and the frames to a settled correct decision of the online and
+  the exact streams.
 - ``live_latency``: streaming every test clip frame by frame, the share of the
   clip after which the class decision is correct and stays so (median), and
   the share of clips whose decision is correct at the end (the batch accuracy).
@@ -241,6 +248,14 @@ def stream_clip(quick):
     return MotionTreeHMM().fit(X[1:], walks.target[1:]), X[0], "synthetic walks, virtual markers"
 
 
+STREAM_SETTINGS = (  # (label, stream keyword arguments)
+    ("exact, window 30", {"mode": "exact", "window": 30}),
+    ("exact, all frames", {"mode": "exact"}),
+    ("online", {"mode": "online"}),
+    ("online, n_best=0", {"mode": "online", "n_best": 0}),
+)
+
+
 def stream_cost(quick):
     model, clip, source = stream_clip(quick)
     n = min(len(clip), 120 if quick else 300)
@@ -251,11 +266,15 @@ def stream_cost(quick):
         model.decode([clip])
 
     rows = []
-    for window in (30, None):
+    for label, kwargs in STREAM_SETTINGS:
         for chunk in (1, 10, 30):
+            if kwargs.get("mode") == "exact" and "window" not in kwargs and chunk == 10:
+                continue  # the slowest setting: two chunk sizes tell its trend
 
-            def run(window=window, chunk=chunk):
-                stream = model.stream(window=window)
+            made = model.stream(**kwargs)  # made once: its tables are not per-frame work
+
+            def run(stream=made, chunk=chunk):
+                stream.reset()
                 for start in range(0, n, chunk):
                     stream.update(clip[start : start + chunk])
 
@@ -267,7 +286,7 @@ def stream_cost(quick):
                     "channels": clip.shape[1],
                     "layers": model.n_layers_,
                     "frames": n,
-                    "window": "all" if window is None else window,
+                    "stream": label,
                     "chunk": chunk,
                     "us per frame": 1e6 * seconds / n,
                     "us per update": 1e6 * seconds / -(-n // chunk),
@@ -275,6 +294,60 @@ def stream_cost(quick):
                     "stream / batch": seconds / batch_s,
                 }
             )
+    # the exact stream (window 30) against the online one, same chunk, same run
+    exact = {r["chunk"]: r["us per frame"] for r in rows if r["stream"] == "exact, window 30"}
+    for row in rows:
+        row["exact (window 30) / this"] = exact[row["chunk"]] / row["us per frame"]
+    return rows
+
+
+def _settled(decisions):
+    """Frames until the decision is correct and stays so (None when wrong at the end)."""
+    if not decisions[-1]:
+        return None
+    wrong = np.flatnonzero(~decisions)
+    return (0 if not len(wrong) else wrong[-1] + 1) + 1
+
+
+def agreement(sets, lag=5):
+    """The online stream against the batch answers and the exact stream, per data set."""
+    rows = []
+    for name, loader in sets.items():
+        Xtr, ytr, Xte, yte = loader()
+        model = MotionTreeHMM().fit(Xtr, ytr)
+        batch_paths, batch_labels = model.decode(Xte), model.predict(Xte)
+        same_node, same_lagged, same_label, correct, settled = [], [], [], [], {}
+        for clip, label, path, batch_label in zip(Xte, yte, batch_paths, batch_labels):
+            for mode in ("online", "exact"):
+                stream = model.stream(mode=mode, lag=lag, n_best=1)
+                states = [stream.update(frame) for frame in clip]
+                decisions = np.array([s.label == label for s in states])
+                settled.setdefault(mode, []).append((_settled(decisions), len(clip)))
+                if mode == "exact":
+                    continue
+                nodes = np.array([s.node for s in states])
+                lagged = np.array([s.lagged_node for s in states])[lag:]
+                same_node.append(nodes == path)
+                same_lagged.append(lagged == path[: len(lagged)])
+                same_label.append(states[-1].label == batch_label)
+                correct.append(states[-1].label == label)
+        row = {
+            "data": name,
+            "test clips": len(Xte),
+            "frames": int(sum(len(c) for c in Xte)),
+            "node = batch decode (filtered)": float(np.mean(np.concatenate(same_node))),
+            f"node = batch decode (lag {lag})": float(np.mean(np.concatenate(same_lagged))),
+            "final label = batch predict": float(np.mean(same_label)),
+            "online accuracy": float(np.mean(correct)),
+            "batch accuracy": float(np.mean(batch_labels == np.asarray(yte))),
+        }
+        for mode, pairs in settled.items():
+            frames = [f for f, _ in pairs if f is not None]
+            shares = [f / n for f, n in pairs if f is not None]
+            row[f"{mode}: median frames to a settled correct decision"] = float(np.median(frames))
+            row[f"{mode}: median share of clip"] = float(np.median(shares))
+        rows.append(row)
+        print(row)
     return rows
 
 
@@ -334,10 +407,12 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="small sizes, synthetic data only")
     parser.add_argument(
-        "--only", nargs="*", help="update, growth, stream, latency, synthesis (default: all)"
+        "--only",
+        nargs="*",
+        help="update, growth, stream, latency, agreement, synthesis (default: all)",
     )
     args = parser.parse_args()
-    only = set(args.only or ["update", "growth", "stream", "latency", "synthesis"])
+    only = set(args.only or ["update", "growth", "stream", "latency", "agreement", "synthesis"])
     sets = datasets(args.quick)
     note = "Shared machine: compare ratios within one run. Default MotionTreeHMM parameters."
     if "update" in only:
@@ -348,6 +423,8 @@ def main():
         write_results("live_growth", growth(sets), notes=note)
     if "latency" in only:
         write_results("live_latency", latency(sets), notes=note)
+    if "agreement" in only:
+        write_results("live_online_agreement", agreement(sets), notes=note)
     if "synthesis" in only:
         write_results("live_synthesis", synthesis(sets), notes=note)
 
