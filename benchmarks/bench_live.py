@@ -358,7 +358,7 @@ def latency(sets):
         model = MotionTreeHMM().fit(Xtr, ytr)
         shares, frames, correct = [], [], []
         for clip, label in zip(Xte, yte):
-            stream = model.stream()
+            stream = model.stream(mode="exact")
             decisions = np.array([stream.update(frame).label == label for frame in clip])
             correct.append(decisions[-1])
             if decisions[-1]:

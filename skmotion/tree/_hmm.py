@@ -762,17 +762,33 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
         return partial_fit(self, X, y, classes, split_growth, rebuild_tol)
 
-    def stream(self, *, layer=None, lag=0, window=None, n_best=3, mode="exact", beam=None):
+    def stream(self, *, layer=None, lag=0, window=None, n_best=3, mode="online", beam=None):
         """An online decoder: recognition and state estimation as frames arrive.
 
         ``stream.update(frames)`` takes one frame or a chunk and returns the
         current node (and its ancestors at every layer above), the node
         ``lag`` frames back, the class posterior and decision, and the most
-        likely next nodes. These are the batch answers (``decode``,
-        ``predict_proba``, ``predict_next``) for the frames seen so far, or
-        for the last ``window`` of them, exactly: the batch beam search is not
-        causal (its beams use every frame of the clip), so the stream decodes
-        its frames again at each update. See
+        likely next nodes. Two modes:
+
+        - ``"online"`` (default): a causal top-down beam kept between calls.
+          Each frame's candidates are the children of its kept nodes, scored
+          by forward max-product recursions on the global graph (the state)
+          and on each class graph (a running log-likelihood per class); a
+          frame costs the same whatever came before (tens of microseconds for
+          32 markers), and the state is ``O(beam x layers)`` numbers. Its
+          answers are not the batch ones: the batch beam keeps the nodes with
+          the best forward + backward scores over the whole clip, which no
+          causal decoder can know. Measured on four data sets, the final
+          label equals ``predict``'s on 95-100% of clips and the node equals
+          ``decode``'s on 90-99% of frames (95-100% with ``lag=5``).
+        - ``"exact"``: the batch answers (``decode``, ``predict_proba``,
+          ``predict_next``) of the frames seen so far, or of the last
+          ``window``, exactly, by decoding them again at each update: about
+          a millisecond or more per update.
+
+        The default is ``"online"`` because a live stream must have a bounded
+        cost per frame (the exact mode without a window grows with the
+        stream). See :class:`~skmotion.tree._online_stream.OnlineMotionStream`,
         :class:`~skmotion.tree._stream.MotionStream` and the user guide
         (``docs/live-database.md``).
 
@@ -783,11 +799,11 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         lag : int, default=0
             Also report the node this many frames back (fixed-lag smoothing).
         window : int, default=None
-            Decode only the last ``window`` frames at each update (bounded
-            cost per update), or all frames so far (None).
+            ``mode="exact"`` only: decode only the last ``window`` frames at
+            each update (bounded cost per update), or all frames so far (None).
         n_best : int, default=3
-            Predicted next nodes per update.
-        mode : {"exact", "online"}, default="exact"
+            Predicted next nodes per update (``mode="online"`` also takes 0).
+        mode : {"online", "exact"}, default="online"
             ``"exact"``: the batch answers of the frames so far, decoded again
             at each update (:class:`~skmotion.tree._stream.MotionStream`).
             ``"online"``: a causal top-down beam kept between calls, a bounded
@@ -814,7 +830,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         ...     state = stream.update(frame)
         >>> bool(state.label == model.predict(X[:1])[0])
         True
-        >>> bool((stream.path() == model.decode(X[:1])[0]).all())
+        >>> exact = model.stream(mode="exact")
+        >>> state = exact.update(X[0])        # a chunk: here the whole clip
+        >>> bool((exact.path() == model.decode(X[:1])[0]).all())
         True
         """
         check_is_fitted(self)

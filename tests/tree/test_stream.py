@@ -1,4 +1,4 @@
-"""MotionStream: fed frame by frame or in chunks, the batch answers exactly."""
+"""The streams: the exact one gives the batch answers; the online one its causal recursions."""
 
 import pickle
 
@@ -35,7 +35,7 @@ MODELS = {
 def test_every_prefix_gives_the_batch_answers(name):
     model = MODELS[name]
     clip = CLIPS[1][::2]  # a walk, every other frame
-    stream = model.stream(lag=3, n_best=2)
+    stream = model.stream(lag=3, n_best=2, mode="exact")
     for t in range(len(clip)):
         state = stream.update(clip[t])
         if t % 7 and t != len(clip) - 1:
@@ -60,7 +60,7 @@ def test_every_prefix_gives_the_batch_answers(name):
 )
 def test_any_chunking_ends_with_the_batch_decode_and_prediction(clip_index, cuts, name):
     model, clip = MODELS[name], CLIPS[clip_index]
-    stream = model.stream()
+    stream = model.stream(mode="exact")
     start = 0
     for size in cuts + [len(clip)]:
         if start >= len(clip):
@@ -77,7 +77,7 @@ def test_any_chunking_ends_with_the_batch_decode_and_prediction(clip_index, cuts
 
 def test_window_gives_the_sliding_window_profile():
     model, clip, width = MODELS["class"], CLIPS[5], 12
-    stream = model.stream(window=width)
+    stream = model.stream(window=width, mode="exact")
     profile = [stream.update(frame).proba for frame in clip]
     expected = model.predict_proba_windows([clip], width)[0]
     np.testing.assert_array_equal(np.array(profile[width - 1 :]), expected)
@@ -85,7 +85,7 @@ def test_window_gives_the_sliding_window_profile():
 
 def test_nodes_are_the_ancestors_of_the_current_node():
     model = MODELS["class"]
-    state = model.stream().update(CLIPS[0][:20])
+    state = model.stream(mode="exact").update(CLIPS[0][:20])
     tree = model.tree_
     assert len(state.nodes) == model.layer_ + 1 and state.nodes[-1] == state.node
     for layer in range(1, model.layer_ + 1):
@@ -96,7 +96,7 @@ def test_nodes_are_the_ancestors_of_the_current_node():
 
 def test_reset_starts_a_new_clip():
     model = MODELS["class"]
-    stream = model.stream()
+    stream = model.stream(mode="exact")
     stream.update(CLIPS[0])
     state = stream.reset().update(CLIPS[6])
     assert state.frame == len(CLIPS[6]) - 1
@@ -105,7 +105,7 @@ def test_reset_starts_a_new_clip():
 
 def test_bad_frames_and_parameters():
     model = MODELS["class"]
-    stream = model.stream()
+    stream = model.stream(mode="exact")
     with pytest.raises(ValueError, match="no frame yet"):
         stream.state()
     with pytest.raises(ValueError, match="channels"):
@@ -116,13 +116,13 @@ def test_bad_frames_and_parameters():
         stream.update(bad)
     for kwargs in ({"lag": -1}, {"window": 0}, {"n_best": 0}):
         with pytest.raises(ValueError, match=next(iter(kwargs))):
-            model.stream(**kwargs)
+            model.stream(**kwargs, mode="exact")
 
 
 @pytest.mark.parametrize("name", ["class", "clip, graph prior"])
 def test_an_upper_layer_streams_its_own_decode(name):
     model, clip = MODELS[name], CLIPS[7]
-    stream = model.stream(layer=2, lag=4)
+    stream = model.stream(layer=2, lag=4, mode="exact")
     for t in range(0, len(clip), 9):
         state = stream.update(clip[t : t + 9])
         prefix = [clip[: t + 9]]
@@ -134,7 +134,7 @@ def test_an_upper_layer_streams_its_own_decode(name):
 
 def test_a_stream_refuses_a_model_fit_again():
     model = MotionTreeHMM(max_depth=3, min_samples_leaf=8).partial_fit(CLIPS[:6], LABELS[:6])
-    stream = model.stream()
+    stream = model.stream(mode="exact")
     stream.update(CLIPS[0][:5])
     model.partial_fit(CLIPS[6:], LABELS[6:])
     with pytest.raises(ValueError, match="start a new stream"):
@@ -332,6 +332,16 @@ def test_online_bad_input():
     with pytest.raises(ValueError, match="window"):
         model.stream(mode="online", window=10)
     with pytest.raises(ValueError, match="beam"):
-        model.stream(beam=4)
+        model.stream(mode="exact", beam=4)
     with pytest.raises(ValueError, match="beam"):
         model.stream(mode="online", beam=0)
+
+
+def test_online_is_the_default_and_refuses_a_model_fit_again():
+    model = MotionTreeHMM(max_depth=3, min_samples_leaf=8).partial_fit(CLIPS[:6], LABELS[:6])
+    stream = model.stream()
+    assert stream.beam == model.n_paths and not hasattr(stream, "window")
+    stream.update(CLIPS[0][:5])
+    model.partial_fit(CLIPS[6:], LABELS[6:])
+    with pytest.raises(ValueError, match="start a new stream"):
+        stream.update(CLIPS[0][5:10])
