@@ -14,8 +14,9 @@ between:
    ``delta_t(j) = max_i delta_{t-1}(i) + (log p(i -> j) + e_t(j))``; the
    ``beam`` best candidates (ties to the lower slot) are the frame's kept nodes;
 4. at the scored layers, the same step under every class (or clip) graph
-   (columns ``1 .. n_graphs``), over the same candidates: a running Viterbi
-   log-likelihood per graph;
+   (columns ``1 .. n_graphs``), over the same candidates, keeping the
+   ``n_paths`` best sequences into each candidate (a list Viterbi): each
+   graph's ``n_paths`` best sequences, whose probabilities the classifier sums;
 5. at the stream's layer, the candidates and back-pointers go to a ring of
    ``lag + 1`` frames, for the fixed-lag answer.
 
@@ -28,7 +29,7 @@ holds only pointers to them and to the model's tables.
 
 import numpy as np
 
-from libc.math cimport INFINITY, exp
+from libc.math cimport INFINITY, exp, log1p
 from libc.stdlib cimport free, malloc
 
 ctypedef Py_ssize_t intp
@@ -75,6 +76,22 @@ cdef inline const double* _moves(const Table* t, intp src, intp dst) noexcept no
     return t.unseen_log + src * t.n_cols
 
 
+cdef inline void _top(double* pool, intp m, double* out, intp P) noexcept nogil:
+    """The ``P`` largest of ``pool[:m]``, largest first, into ``out`` (-inf past ``m``); ``pool`` is spoilt."""
+    cdef intp r, i, arg
+    cdef double best
+    for r in range(P):
+        arg = -1
+        best = -INFINITY
+        for i in range(m):
+            if pool[i] > best:
+                best = pool[i]
+                arg = i
+        out[r] = best
+        if arg >= 0:
+            pool[arg] = -INFINITY
+
+
 cdef class OnlineKernel:
     """The per-frame update loop over one model's tables and one stream's state arrays.
 
@@ -88,12 +105,12 @@ cdef class OnlineKernel:
         pair_dst, pair_log, unseen_log, allowed, log_norm, scored)``.
     state : dict
         The stream's arrays (see :class:`~skmotion.tree._online_stream.OnlineMotionStream`).
-    beam, n_graphs, stream_layer, ring : int
+    beam, n_graphs, n_paths, stream_layer, ring : int
     """
 
     cdef object _keep              # the arrays the pointers point into
     cdef Layer* _layers
-    cdef intp n_layers, beam, slots, n_graphs, stream_layer, ring, d
+    cdef intp n_layers, beam, slots, n_graphs, n_paths, stream_layer, ring, d
     # Gaussians
     cdef const double* means
     cdef const double* prec
@@ -112,7 +129,7 @@ cdef class OnlineKernel:
     cdef intp* n_kept        # (n_layers + 1,)
     cdef double* emit        # (n_layers + 1, slots) their log densities
     cdef double* delta       # (n_layers + 1, slots) global forward scores (minus the offset)
-    cdef double* alpha       # (n_layers + 1, slots, n_graphs) per-graph forward scores (minus the offset)
+    cdef double* alpha       # (n_layers + 1, slots, n_graphs, n_paths) per-graph list scores (minus the offset)
     cdef double* delta_off   # (n_layers + 1,)
     cdef double* alpha_off   # (n_layers + 1,)
     cdef intp* ring_cand     # (ring, slots) the stream layer's candidates of the last `ring` frames
@@ -121,6 +138,7 @@ cdef class OnlineKernel:
     # scratch
     cdef double* new_delta
     cdef double* new_alpha
+    cdef double* pool        # (slots * n_paths,) the entries a list step picks from
     cdef double* new_emit
     cdef intp* new_cand
     cdef intp* parent_slot
@@ -131,20 +149,22 @@ cdef class OnlineKernel:
         self._layers = NULL
         self.new_delta = NULL
         self.new_alpha = NULL
+        self.pool = NULL
         self.new_emit = NULL
         self.new_cand = NULL
         self.parent_slot = NULL
         self.back = NULL
         self.y = NULL
 
-    def __init__(self, dict gauss, list layers, dict state, intp beam, intp n_graphs, intp stream_layer,
-                 intp ring):
+    def __init__(self, dict gauss, list layers, dict state, intp beam, intp n_graphs, intp n_paths,
+                 intp stream_layer, intp ring):
         keep = [gauss, layers, state]
         self._keep = keep
         self.n_layers = len(layers)
         self.beam = beam
         self.slots = 2 * beam
         self.n_graphs = n_graphs
+        self.n_paths = n_paths
         self.stream_layer = stream_layer
         self.ring = ring
         self._set_gaussians(gauss)
@@ -155,13 +175,14 @@ cdef class OnlineKernel:
         self._set_state(state)
         cdef intp s = self.slots, g = max(n_graphs, 1)
         self.new_delta = <double*> malloc(s * sizeof(double))
-        self.new_alpha = <double*> malloc(s * g * sizeof(double))
+        self.new_alpha = <double*> malloc(s * g * n_paths * sizeof(double))
+        self.pool = <double*> malloc(s * n_paths * sizeof(double))
         self.new_emit = <double*> malloc(s * sizeof(double))
         self.new_cand = <intp*> malloc(s * sizeof(intp))
         self.parent_slot = <intp*> malloc(s * sizeof(intp))
         self.back = <intp*> malloc(s * sizeof(intp))
         self.y = <double*> malloc(4 * max(self.d, 1) * sizeof(double))
-        if (self.new_delta == NULL or self.new_alpha == NULL or self.new_emit == NULL or self.new_cand == NULL
+        if (self.new_delta == NULL or self.new_alpha == NULL or self.pool == NULL or self.new_emit == NULL or self.new_cand == NULL
                 or self.parent_slot == NULL or self.back == NULL or self.y == NULL):
             raise MemoryError()
 
@@ -169,6 +190,7 @@ cdef class OnlineKernel:
         free(self._layers)
         free(self.new_delta)
         free(self.new_alpha)
+        free(self.pool)
         free(self.new_emit)
         free(self.new_cand)
         free(self.parent_slot)
@@ -227,7 +249,7 @@ cdef class OnlineKernel:
         cdef intp[::1] n_kept = state["n_kept"]
         cdef double[:, ::1] emit = state["emit"]
         cdef double[:, ::1] delta = state["delta"]
-        cdef double[:, :, ::1] alpha = state["alpha"]
+        cdef double[:, :, :, ::1] alpha = state["alpha"]
         cdef double[::1] delta_off = state["delta_off"]
         cdef double[::1] alpha_off = state["alpha_off"]
         cdef intp[:, ::1] ring_cand = state["ring_cand"]
@@ -239,7 +261,7 @@ cdef class OnlineKernel:
         self.n_kept = &n_kept[0]
         self.emit = &emit[0, 0]
         self.delta = &delta[0, 0]
-        self.alpha = &alpha[0, 0, 0]
+        self.alpha = &alpha[0, 0, 0, 0]
         self.delta_off = &delta_off[0]
         self.alpha_off = &alpha_off[0]
         self.ring_cand = &ring_cand[0, 0]
@@ -328,43 +350,45 @@ cdef class OnlineKernel:
         self.n_kept[l] = m
 
     cdef void _classes(self, intp l, intp n, bint first) noexcept nogil:
-        """Every graph's max-product step at a scored layer, over the new candidates."""
+        """Every graph's list step at a scored layer: the ``n_paths`` best sequences into each new candidate.
+
+        Entry ``(j, g, r)``: the rank-``r`` sequence under graph ``g`` ending in
+        candidate ``j`` (decreasing in ``r``; -inf when there are fewer).
+        """
         cdef const Layer* lay = &self._layers[l - 1]
-        cdef intp i, j, g, G = self.n_graphs, n_prev = self.n_cand[l]
-        cdef double e, v, top = -INFINITY
+        cdef intp i, j, g, r, m, G = self.n_graphs, P = self.n_paths, n_prev = self.n_cand[l]
+        cdef intp size = n * G * P
+        cdef double e, move, top = -INFINITY
         cdef const intp* prev = self.cand + l * self.slots
-        cdef const double* prev_alpha = self.alpha + l * self.slots * G
-        cdef const double* moves
+        cdef const double* prev_alpha = self.alpha + l * self.slots * G * P
         cdef double* out
         for j in range(n):
-            out = self.new_alpha + j * G
             for g in range(G):
-                out[g] = -INFINITY
-            for g in range(G):
+                out = self.new_alpha + (j * G + g) * P
+                for r in range(P):
+                    out[r] = -INFINITY
                 if lay.allowed != NULL and not lay.allowed[g * lay.k + self.new_cand[j]]:
                     continue
                 e = self.new_emit[j]
                 if lay.log_norm != NULL:
                     e = e - lay.log_norm[g]
                 if first:
-                    out[g] = e
-                    continue
-                for i in range(n_prev):
-                    moves = _moves(&lay.table, prev[i], self.new_cand[j])
-                    v = prev_alpha[i * G + g] + (moves[1 + g] + e)
-                    if v > out[g]:
-                        out[g] = v
-            for g in range(G):
-                if out[g] > top:
-                    top = out[g]
+                    out[0] = e
+                else:
+                    m = 0
+                    for i in range(n_prev):
+                        move = _moves(&lay.table, prev[i], self.new_cand[j])[1 + g]
+                        for r in range(P):
+                            self.pool[m] = prev_alpha[(i * G + g) * P + r] + (move + e)
+                            m += 1
+                    _top(self.pool, m, out, P)
+                if out[0] > top:
+                    top = out[0]
         if top == -INFINITY:
             top = 0.0
-        for j in range(n * G):
-            self.new_alpha[j] -= top
+        for j in range(size):
+            self.alpha[l * self.slots * G * P + j] = self.new_alpha[j] - top
         self.alpha_off[l] += top
-        for j in range(n * G):
-            self.alpha[l * self.slots * G + j] = self.new_alpha[j]
-
 
     cdef void _frame(self, const double* x, intp t) noexcept nogil:
         """One frame through every layer."""
@@ -451,21 +475,32 @@ cdef class OnlineKernel:
                 next_proba[0] = 1.0
         return node, lag_node, label
 
+    cdef double _sum_of_paths(self, intp l, intp g) noexcept nogil:
+        """``log sum exp`` of graph ``g``'s ``n_paths`` best sequences at layer ``l`` (as the batch sums them)."""
+        cdef intp j, r, m = 0, G = self.n_graphs, P = self.n_paths
+        cdef double* best = self.new_alpha  # scratch: the step's buffer, free between frames
+        cdef double rest = 0.0
+        for j in range(self.n_cand[l]):
+            for r in range(P):
+                self.pool[m] = self.alpha[((l * self.slots + j) * G + g) * P + r]
+                m += 1
+        _top(self.pool, m, best, P)
+        if best[0] == -INFINITY:
+            return best[0]
+        for r in range(1, P):
+            rest += exp(best[r] - best[0])
+        return best[0] + log1p(rest)
+
     cdef intp _posterior(self, const intp[::1] class_of_graph, double[::1] proba):
         cdef intp l, j, g, c, n_classes = proba.shape[0], G = self.n_graphs, arg = 0
         cdef double* ll = <double*> malloc(max(G, 1) * sizeof(double))
-        cdef double best, top = -INFINITY, total = 0.0
+        cdef double top = -INFINITY, total = 0.0
         for g in range(G):
             ll[g] = 0.0
         for l in range(1, self.n_layers + 1):
-            if not self._layers[l - 1].scored:
-                continue
-            for g in range(G):
-                best = -INFINITY
-                for j in range(self.n_cand[l]):
-                    if self.alpha[(l * self.slots + j) * G + g] > best:
-                        best = self.alpha[(l * self.slots + j) * G + g]
-                ll[g] += best + self.alpha_off[l]
+            if self._layers[l - 1].scored:
+                for g in range(G):
+                    ll[g] += self._sum_of_paths(l, g) + self.alpha_off[l]
         for c in range(n_classes):
             proba[c] = -INFINITY
         for g in range(G):

@@ -12,29 +12,31 @@ the root down:
   the best node sequence ending in ``j`` whose every node was a candidate of its
   frame. The ``beam`` best candidates are kept: ``B_t^l``;
 - at the classifying layers (``score_layers_``), every class (or clip) graph
-  ``g`` runs the same recursion over the same candidates,
-  ``alpha_t^g(j) = max_i [alpha_{t-1}^g(i) + log p_g(i -> j)] + log Ps_g(x_t | j)``;
-  the class's running log-likelihood is ``sum over scored layers of max_j
-  alpha_t^g(j)``, the log probability of the class graph's best sequence
-  through the candidates (with ``graph="clip"``, a class's value is its best
-  clip's). ``Ps_g`` is ``Po`` divided by the graph's normaliser under
-  ``node_prior="graph"``; under ``"layer"`` the normaliser is common to all
-  classes and left out, as ``predict_proba`` leaves it out.
+  ``g`` runs the same recursion over the same candidates as a list Viterbi:
+  ``alpha_t^g(j, r)``, the ``r``-th best of ``alpha_{t-1}^g(i, s) + log p_g(i
+  -> j) + log Ps_g(x_t | j)`` over ``i`` and ``s``, for ``r < n_paths``: the
+  ``n_paths`` best sequences under ``g`` ending in ``j`` whose nodes were all
+  candidates. The class's running log-likelihood is, summed over the scored
+  layers, ``log`` of the summed probabilities of the ``n_paths`` best
+  ``alpha_t^g`` entries over all candidates: the batch classifier's
+  generation probability (``n_paths`` best sequences summed) on the causal
+  beam (with ``graph="clip"``, a class's value is its best clip's). ``Ps_g``
+  is ``Po`` divided by the graph's normaliser under ``node_prior="graph"``;
+  under ``"layer"`` the normaliser is common to all classes and left out, as
+  ``predict_proba`` leaves it out.
 
 This is the batch decoder made causal: a frame's beam depends on the frames
-before it only (forward scores instead of forward + backward max-marginals),
-and each class keeps its best sequence rather than the sum of its ``n_paths``
-best ones. With a beam as wide as the widest layer every node is a candidate,
-and the recursions are the exhaustive forward Viterbi over all nodes: the
-current node is the last node of :func:`~skmotion.tree.exhaustive_viterbi` of
-the frames so far, and the class log-likelihood is its score under the class
-graph (what ``score_samples`` gives with ``n_paths=1`` and a beam that prunes
-nothing). The tests check both against numpy references.
+before it only (forward scores instead of forward + backward max-marginals).
+With a beam as wide as the widest layer every node is a candidate, and the
+recursions are the exhaustive (list) Viterbi over all nodes: the current node
+is the last node of :func:`~skmotion.tree.exhaustive_viterbi` of the frames so
+far, and the class log-likelihood sums its ``n_paths`` best scores under the
+class graph. The tests check both against numpy references.
 
 The state kept between calls is, per layer, the last frame's candidates (at
 most ``2 beam``), their scores under the global and the class graphs, plus, at
 the stream's layer, ``lag + 1`` frames of candidates and back-pointers for the
-fixed-lag answer: ``O(beam x layers x n_graphs + beam x lag)`` numbers, and a
+fixed-lag answer: ``O(beam x layers x n_graphs x n_paths + beam x lag)`` numbers, and a
 frame costs the same whatever came before. The per-frame loop is compiled
 (:mod:`skmotion.tree._online`).
 """
@@ -44,7 +46,7 @@ from sklearn.utils import Bunch
 
 from skmotion.tree._decode import _log_normaliser
 from skmotion.tree._online import OnlineKernel
-from skmotion.tree._stream import _check_int
+from skmotion.tree._stream import _check_int, _sum_of_paths
 
 __all__ = ["OnlineMotionStream"]
 
@@ -128,6 +130,7 @@ class OnlineMotionStream:
         self._depth = max(self.layer, model.layer_)
         self._scored = [int(s) for s in model.score_layers_ if s > 0]
         self._n_graphs = model.graphs_.n_graphs
+        self._n_paths = int(model.n_paths)
         self._build()
         self.reset()
 
@@ -159,7 +162,7 @@ class OnlineMotionStream:
             "n_kept": np.zeros(n, dtype=np.intp),
             "emit": np.zeros((n, s)),
             "delta": np.zeros((n, s)),
-            "alpha": np.zeros((n, s, max(self._n_graphs, 1))),
+            "alpha": np.zeros((n, s, max(self._n_graphs, 1), self._n_paths)),
             "delta_off": np.zeros(n),
             "alpha_off": np.zeros(n),
             "ring_cand": np.full((self.lag + 1, s), -1, dtype=np.intp),
@@ -177,6 +180,7 @@ class OnlineMotionStream:
             self._state,
             self.beam,
             self._n_graphs,
+            self._n_paths,
             self.layer,
             self.lag + 1,
         )
@@ -252,7 +256,11 @@ class OnlineMotionStream:
         return self.state()
 
     def class_log_likelihood(self):
-        """Each graph's running log-likelihood: its best sequence's score over the scored layers.
+        """Each graph's running log-likelihood, summed over the scored layers.
+
+        At a scored layer: ``log`` of the summed probabilities of the graph's
+        ``n_paths`` best sequences through the candidates (the batch
+        classifier's generation probability, on the causal beam).
 
         Returns
         -------
@@ -262,7 +270,10 @@ class OnlineMotionStream:
         st = self._state
         out = np.zeros(self._n_graphs)
         for depth in self._scored:
-            out += st["alpha"][depth, : st["n_cand"][depth]].max(axis=0) + st["alpha_off"][depth]
+            entries = st["alpha"][depth, : st["n_cand"][depth]]  # (n_cand, n_graphs, n_paths)
+            entries = np.moveaxis(entries, 1, 0).reshape(self._n_graphs, -1)
+            best = -np.sort(-entries, axis=1)[:, : self._n_paths]
+            out += _sum_of_paths(best) + st["alpha_off"][depth]
         return out
 
     def state(self):

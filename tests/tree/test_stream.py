@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTreeHMM, exhaustive_viterbi
 from skmotion.tree._decode import _log_normaliser
+from skmotion.tree._stream import _sum_of_paths
 
 
 def _data():
@@ -175,15 +176,21 @@ def test_online_with_every_node_kept_is_the_exhaustive_forward_viterbi(name):
         path, _ = exhaustive_viterbi(tree, model.global_graph_, layer, prefix, node_prior="layer")
         assert state.node == path[0, -1]
         assert state.lagged_node == (path[0, -1 - lag] if t >= lag else -1)
-        # each graph's best score over all node sequences, at every scored layer; under
+        # each graph's n_paths best scores over all node sequences, summed, per scored layer; under
         # node_prior="layer" the online scores leave out the normaliser common to all graphs
         expected = np.zeros(model.graphs_.n_graphs)
         for depth in model.score_layers_:
             for g in range(len(expected)):
                 _, score = exhaustive_viterbi(
-                    tree, model.graphs_, depth, prefix, g, node_prior=model.node_prior
+                    tree,
+                    model.graphs_,
+                    depth,
+                    prefix,
+                    g,
+                    n_paths=model.n_paths,
+                    node_prior=model.node_prior,
                 )
-                expected[g] += score[0]
+                expected[g] += _sum_of_paths(score)
             if model.node_prior == "layer":
                 log_po = tree.log_likelihood(prefix, depth)
                 expected += _log_normaliser(log_po, np.ones((1, log_po.shape[1]), bool)).sum()
@@ -202,7 +209,7 @@ def _reference(model, frames, beam, layer):
     history = {depth: [] for depth in range(1, depth_max + 1)}  # (candidates, back-pointers)
     delta = {depth: None for depth in history}
     alpha = {depth: None for depth in history}
-    n_graphs = model.graphs_.n_graphs
+    n_graphs, n_paths = model.graphs_.n_graphs, model.n_paths
     for x in std:
         kept = np.array([0])
         for depth in range(1, depth_max + 1):
@@ -223,14 +230,16 @@ def _reference(model, frames, beam, layer):
                     allowed = model.graphs_.visits(depth) > 0
                     norm = _log_normaliser(tree.log_likelihood(x[None], depth), allowed)[0]
                     log_ps = np.where(allowed[:, cand], log_ps - norm[:, None], -np.inf)
-                if prev is None:
-                    alpha[depth] = log_ps
+                if prev is None:  # (graph, candidate, rank)
+                    alpha[depth] = np.full((n_graphs, len(cand), n_paths), -np.inf)
+                    alpha[depth][:, :, 0] = log_ps
                 else:
                     g = np.arange(n_graphs)[:, None, None]
                     moves = model.graphs_.log_prob(depth, g, prev[None, :, None], cand[None, None])
-                    alpha[depth] = (alpha[depth][:, :, None] + (moves + log_ps[:, None])).max(
-                        axis=1
-                    )
+                    # (graph, previous candidate, candidate, rank) -> the n_paths best per candidate
+                    step = alpha[depth][:, :, None, :] + (moves + log_ps[:, None])[..., None]
+                    step = np.moveaxis(step, 2, 1).reshape(n_graphs, len(cand), -1)
+                    alpha[depth] = -np.sort(-step, axis=2)[:, :, :n_paths]
             history[depth].append((cand, back))
             delta[depth] = new
             order = np.argsort(-new, kind="stable")[:beam]
@@ -241,7 +250,10 @@ def _reference(model, frames, beam, layer):
         slot = back[slot]
     order = np.argsort(-delta[layer], kind="stable")[:beam]
     weights = np.exp(delta[layer][order] - delta[layer][order[0]])
-    log_lik = sum(alpha[d].max(axis=1) for d in model.score_layers_ if d > 0)
+    log_lik = 0.0
+    for d in model.score_layers_[model.score_layers_ > 0]:
+        best = -np.sort(-alpha[d].reshape(n_graphs, -1), axis=1)[:, :n_paths]
+        log_lik = log_lik + _sum_of_paths(best)
     return np.array(path[::-1]), log_lik, history[layer][-1][0][order], weights / weights.sum()
 
 
