@@ -278,7 +278,7 @@ class OnlineMotionStream:
 
     def state(self):
         """The answers for the frames seen so far (see :meth:`update`)."""
-        n_frames = self.n_frames
+        n_frames = int(self._state["n_frames"][0])
         if n_frames == 0:
             raise ValueError("the stream has seen no frame yet; call update first.")
         proba = np.empty(len(self.model.classes_))
