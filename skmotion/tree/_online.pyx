@@ -143,6 +143,7 @@ cdef class OnlineKernel:
     cdef intp* new_cand
     cdef intp* parent_slot
     cdef intp* back
+    cdef intp* union_slot    # (K at the stream layer,) a node's entry in the next-node union, -1 for none
     cdef double* y
 
     def __cinit__(self):
@@ -154,6 +155,7 @@ cdef class OnlineKernel:
         self.new_cand = NULL
         self.parent_slot = NULL
         self.back = NULL
+        self.union_slot = NULL
         self.y = NULL
 
     def __init__(self, dict gauss, list layers, dict state, intp beam, intp n_graphs, intp n_paths,
@@ -182,6 +184,12 @@ cdef class OnlineKernel:
         self.parent_slot = <intp*> malloc(s * sizeof(intp))
         self.back = <intp*> malloc(s * sizeof(intp))
         self.y = <double*> malloc(4 * max(self.d, 1) * sizeof(double))
+        cdef intp k = self._layers[stream_layer - 1].k if stream_layer else 1, i
+        self.union_slot = <intp*> malloc(k * sizeof(intp))
+        if self.union_slot == NULL:
+            raise MemoryError()
+        for i in range(k):
+            self.union_slot[i] = -1
         if (self.new_delta == NULL or self.new_alpha == NULL or self.pool == NULL or self.new_emit == NULL or self.new_cand == NULL
                 or self.parent_slot == NULL or self.back == NULL or self.y == NULL):
             raise MemoryError()
@@ -195,6 +203,7 @@ cdef class OnlineKernel:
         free(self.new_cand)
         free(self.parent_slot)
         free(self.back)
+        free(self.union_slot)
         free(self.y)
 
     cdef void _set_gaussians(self, dict gauss):
@@ -546,15 +555,15 @@ cdef class OnlineKernel:
             m = self.cand[L * self.slots + self.kept[L * self.beam + w]]
             unseen = exp(t.unseen_log[m * t.n_cols])
             for p in range(t.pair_start[m], t.pair_start[m + 1]):
-                for u in range(n_union):
-                    if dests[u] == t.pair_dst[p]:
-                        break
-                else:
-                    u = n_union
+                u = self.union_slot[t.pair_dst[p]]
+                if u < 0:
+                    u = self.union_slot[t.pair_dst[p]] = n_union
                     dests[u] = t.pair_dst[p]
                     value[u] = base
                     n_union += 1
                 value[u] += weight[w] * (exp(t.pair_log[p * t.n_cols]) - unseen)
+        for u in range(n_union):
+            self.union_slot[dests[u]] = -1
         for r in range(n_best):
             arg = -1
             best = -INFINITY
