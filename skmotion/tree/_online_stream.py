@@ -106,6 +106,29 @@ class OnlineMotionStream:
     ----------
     n_frames : int
         Frames seen so far.
+
+    Notes
+    -----
+    Under ``node_prior="graph"`` each class graph's normaliser of ``Ps`` needs
+    the density of every node of the scored layers; it is computed in numpy
+    before each frame, a slower path than the compiled one of the default
+    ``node_prior="layer"``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.tree import MotionTreeHMM
+    >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+    >>> X = [clip[:, 6:] for clip in data.clips]
+    >>> model = MotionTreeHMM(max_depth=4).fit(X, data.target)
+    >>> stream = model.stream(mode="online", lag=3)
+    >>> for frame in X[5]:
+    ...     state = stream.update(frame)
+    >>> bool(state.label == model.predict(X[5:6])[0]), state.proba.round(2).tolist()
+    (True, [0.0, 1.0])
+    >>> len(state.nodes) == model.layer_ + 1, stream.n_frames == len(X[5])
+    (True, True)
     """
 
     def __init__(self, model, *, layer=None, lag=0, beam=None, n_best=3):
