@@ -60,6 +60,13 @@ cdef struct Layer:
     Table table
     intp k
     bint scored
+    # the moves between the last two candidate lists (a node holds for many frames, so the
+    # lists repeat): (n_src, n_dst, n_cols) values, looked up again only when a list changes
+    double* moves
+    intp* move_src
+    intp* move_dst
+    intp n_src
+    intp n_dst
 
 
 cdef inline const double* _moves(const Table* t, intp src, intp dst) noexcept nogil:
@@ -110,7 +117,7 @@ cdef class OnlineKernel:
 
     cdef object _keep              # the arrays the pointers point into
     cdef Layer* _layers
-    cdef intp n_layers, beam, slots, n_graphs, n_paths, stream_layer, ring, d
+    cdef intp n_layers, beam, slots, n_graphs, n_paths, stream_layer, ring, d, _n_made
     # Gaussians
     cdef const double* means
     cdef const double* prec
@@ -148,6 +155,7 @@ cdef class OnlineKernel:
 
     def __cinit__(self):
         self._layers = NULL
+        self._n_made = 0
         self.new_delta = NULL
         self.new_alpha = NULL
         self.pool = NULL
@@ -171,9 +179,17 @@ cdef class OnlineKernel:
         self.ring = ring
         self._set_gaussians(gauss)
         self._layers = <Layer*> malloc(max(self.n_layers, 1) * sizeof(Layer))
+        if self._layers == NULL:
+            raise MemoryError()
         cdef intp l
         for l in range(self.n_layers):
+            self._layers[l].moves = NULL
+            self._layers[l].move_src = NULL
+            self._layers[l].move_dst = NULL
+        self._n_made = 0
+        for l in range(self.n_layers):
             self._layers[l] = self._layer(layers[l])
+            self._n_made = l + 1
         self._set_state(state)
         cdef intp s = self.slots, g = max(n_graphs, 1)
         self.new_delta = <double*> malloc(s * sizeof(double))
@@ -195,6 +211,12 @@ cdef class OnlineKernel:
             raise MemoryError()
 
     def __dealloc__(self):
+        cdef intp l
+        if self._layers != NULL:
+            for l in range(self._n_made):
+                free(self._layers[l].moves)
+                free(self._layers[l].move_src)
+                free(self._layers[l].move_dst)
         free(self._layers)
         free(self.new_delta)
         free(self.new_alpha)
@@ -249,6 +271,13 @@ cdef class OnlineKernel:
         out.log_norm = &log_norm[0] if log_norm.shape[0] else NULL
         out.k = ids.shape[0]
         out.scored = spec[8]
+        out.moves = <double*> malloc(self.slots * self.slots * out.table.n_cols * sizeof(double))
+        out.move_src = <intp*> malloc(self.slots * sizeof(intp))
+        out.move_dst = <intp*> malloc(self.slots * sizeof(intp))
+        out.n_src = -1
+        out.n_dst = -1
+        if out.moves == NULL or out.move_src == NULL or out.move_dst == NULL:
+            raise MemoryError()
         return out
 
     cdef void _set_state(self, dict state):
@@ -315,13 +344,44 @@ cdef class OnlineKernel:
                 n += 1
         return n
 
+    cdef const double* _move_table(self, intp l, intp n) noexcept nogil:
+        """``log p(i -> j)`` in every column, ``(n_prev, n, n_cols)``, from the previous frame's candidates."""
+        cdef Layer* lay = &self._layers[l - 1]
+        cdef intp i, j, c, n_prev = self.n_cand[l], cols = lay.table.n_cols
+        cdef const intp* prev = self.cand + l * self.slots
+        cdef const double* move
+        if lay.n_src == n_prev and lay.n_dst == n:
+            for i in range(n_prev):
+                if lay.move_src[i] != prev[i]:
+                    break
+            else:
+                for j in range(n):
+                    if lay.move_dst[j] != self.new_cand[j]:
+                        break
+                else:
+                    return lay.moves
+        for i in range(n_prev):
+            lay.move_src[i] = prev[i]
+            for j in range(n):
+                move = _moves(&lay.table, prev[i], self.new_cand[j])
+                for c in range(cols):
+                    lay.moves[(i * n + j) * cols + c] = move[c]
+        for j in range(n):
+            lay.move_dst[j] = self.new_cand[j]
+        lay.n_src = n_prev
+        lay.n_dst = n
+        return lay.moves
+
     cdef void _forward(self, intp l, intp n, bint first) noexcept nogil:
         """The global graph's max-product step at layer ``l`` over its ``n`` new candidates."""
         cdef const Layer* lay = &self._layers[l - 1]
         cdef intp i, j, arg, n_prev = self.n_cand[l]
         cdef double best, v
-        cdef const intp* prev = self.cand + l * self.slots
         cdef const double* prev_delta = self.delta + l * self.slots
+        cdef const double* moves = NULL
+        cdef intp cols = lay.table.n_cols
+        if not first:
+            moves = self._move_table(l, n)
         for j in range(n):
             if first:
                 self.new_delta[j] = self.new_emit[j]
@@ -330,7 +390,7 @@ cdef class OnlineKernel:
             best = -INFINITY
             arg = -1
             for i in range(n_prev):
-                v = prev_delta[i] + (_moves(&lay.table, prev[i], self.new_cand[j])[0] + self.new_emit[j])
+                v = prev_delta[i] + (moves[(i * n + j) * cols] + self.new_emit[j])
                 if v > best:
                     best = v
                     arg = i
@@ -368,9 +428,12 @@ cdef class OnlineKernel:
         cdef intp i, j, g, r, m, G = self.n_graphs, P = self.n_paths, n_prev = self.n_cand[l]
         cdef intp size = n * G * P
         cdef double e, move, top = -INFINITY
-        cdef const intp* prev = self.cand + l * self.slots
         cdef const double* prev_alpha = self.alpha + l * self.slots * G * P
+        cdef const double* moves = NULL
+        cdef intp cols = lay.table.n_cols
         cdef double* out
+        if not first:
+            moves = self._move_table(l, n)  # made by the global step just before: a cache hit
         for j in range(n):
             for g in range(G):
                 out = self.new_alpha + (j * G + g) * P
@@ -386,7 +449,7 @@ cdef class OnlineKernel:
                 else:
                     m = 0
                     for i in range(n_prev):
-                        move = _moves(&lay.table, prev[i], self.new_cand[j])[1 + g]
+                        move = moves[(i * n + j) * cols + 1 + g]
                         for r in range(P):
                             self.pool[m] = prev_alpha[(i * G + g) * P + r] + (move + e)
                             m += 1
