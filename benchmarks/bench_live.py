@@ -20,7 +20,9 @@ Result tables, all measured in one run:
   frames, or all frames) and the online one, against the chunk size; the ratio
   to the batch ``predict`` + ``decode`` of the same frames (timed in
   alternation) and to the exact stream with a 30-frame window; also the fastest
-  of five more runs (the cost with the least interference from other jobs).
+  of five more runs (the cost with the least interference from other jobs), and
+  the online stream's single-frame cost after 3000 frames (the same frames
+  again: a cost that does not grow with the stream).
 - ``live_online_agreement``: the online (causal) stream against the batch
   answers, per data set: the share of frames whose current node (and node
   ``lag`` = 5 frames back) equals the batch ``decode`` of the whole clip at the
@@ -298,11 +300,41 @@ def stream_cost(quick):
                     "stream / batch": seconds / batch_s,
                 }
             )
+    rows.append(_online_after(model, clip, source, batch))
     # the exact stream (window 30) against the online one, same chunk, same run
     exact = {r["chunk"]: r["us per frame"] for r in rows if r["stream"] == "exact, window 30"}
     for row in rows:
         row["exact (window 30) / this"] = exact[row["chunk"]] / row["us per frame"]
     return rows
+
+
+def _online_after(model, clip, source, batch, n_before=3000):
+    """The online stream's single-frame cost after ``n_before`` frames: the same as at the start."""
+    n = len(clip)
+    stream = model.stream()
+    before = np.resize(clip, (n_before, clip.shape[1]))  # the clip again and again
+    times = []
+    for _ in range(3):
+        stream.reset().update(before)
+        start = time.perf_counter()
+        for frame in clip:
+            stream.update(frame)
+        times.append(time.perf_counter() - start)
+    batch_s = time_call(batch, repeats=3)[0]
+    seconds, fastest = float(np.median(times)), min(times)
+    return {
+        "data": source,
+        "channels": clip.shape[1],
+        "layers": model.n_layers_,
+        "frames": n,
+        "stream": f"online, after {n_before} frames",
+        "chunk": 1,
+        "us per frame": 1e6 * seconds / n,
+        "us per frame, fastest of 5": 1e6 * fastest / n,  # of 3 here
+        "us per update": 1e6 * seconds / n,
+        "batch predict+decode, us per frame": 1e6 * batch_s / n,
+        "stream / batch": seconds / batch_s,
+    }
 
 
 def _settled(decisions):
