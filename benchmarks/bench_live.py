@@ -382,6 +382,16 @@ def agreement(sets, lag=5):
             shares = [f / n for f, n in pairs if f is not None]
             row[f"{mode}: median frames to a settled correct decision"] = float(np.median(frames))
             row[f"{mode}: median share of clip"] = float(np.median(shares))
+        for beam in (6, 12):  # wider online beams (the default is n_paths = 3)
+            nodes, labels = [], []
+            for clip, path in zip(Xte, batch_paths):
+                stream = model.stream(beam=beam, n_best=0)
+                nodes.append(np.array([stream.update(frame).node for frame in clip]) == path)
+                labels.append(stream.state().label)
+            row[f"beam {beam}: node = batch decode"] = float(np.mean(np.concatenate(nodes)))
+            row[f"beam {beam}: final label = batch predict"] = float(
+                np.mean(np.array(labels) == batch_labels)
+            )
         rows.append(row)
         print(row)
     return rows
