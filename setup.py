@@ -10,4 +10,11 @@ beam = Extension(
     depends=["skmotion/tree/_emission.h"],
     extra_compile_args=["-O3", "-fopenmp-simd"],
 )
-setup(ext_modules=cythonize([beam]))
+# The causal stream's per-frame update (tree/_online_stream.py), the same flags.
+online = Extension(
+    "skmotion.tree._online",
+    ["skmotion/tree/_online.pyx"],
+    depends=["skmotion/tree/_emission.h"],
+    extra_compile_args=["-O3", "-fopenmp-simd"],
+)
+setup(ext_modules=cythonize([beam, online]))

@@ -50,7 +50,7 @@ def _stream(model, X_test, y_test, lines):
     b = int(np.flatnonzero(y_test == "jump")[0])
     clip = np.concatenate([X_test[a], X_test[b]])
     switch = len(X_test[a])
-    stream = model.stream(window=_WINDOW, lag=5)
+    stream = model.stream(mode="exact", window=_WINDOW, lag=5)
     states = [stream.update(frame) for frame in clip]
     proba = np.array([s.proba for s in states])
     labels = np.array([s.label for s in states])
@@ -62,7 +62,7 @@ def _stream(model, X_test, y_test, lines):
         f"right at {np.mean(labels == right):.0%} of frames; 'jump' for good {after} frames "
         "after the switch"
     )
-    whole = model.stream()
+    whole = model.stream(mode="exact")
     for start in range(0, len(X_test[b]), 7):  # chunks of 7 frames
         last = whole.update(X_test[b][start : start + 7])
     same = bool((whole.path() == model.decode([X_test[b]])[0]).all())
