@@ -1,8 +1,8 @@
 """Planning on a motion database: root motion per node, the search, and the planned motion.
 
-Knows nothing of sklearn: :meth:`MotionTreeHMM.plan` validates its input and
-calls :func:`plan_motion` with the node means and transition counts of one
-layer.
+Knows nothing of sklearn: :func:`plan_from_database` (behind
+:meth:`MotionTreeHMM.plan`) validates its input and calls :func:`plan_motion`
+with the node means and transition counts of one layer.
 """
 
 import math
@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skmotion.io import Motion
+from skmotion.kinematics import body_size as chain_size
 from skmotion.kinematics import euler_to_matrix, matrix_to_euler, yaw_matrix
 from skmotion.planning._ik import damped_ik, facing_pose, plan_axes
 from skmotion.planning._root_motion import planar_step, rigid_root_velocity, skeleton_root_velocity
 from skmotion.planning._search import astar_search
-from skmotion.preprocessing._body_frame import body_size as chain_size
 
 __all__ = ["MotionPlan", "SkeletonModel", "default_body_size", "node_root_velocity", "plan_motion"]
 

@@ -16,13 +16,12 @@ its kept nodes. :func:`exhaustive_viterbi` searches all nodes of a layer, for
 reference and small problems.
 """
 
-from numbers import Integral
-
 import numpy as np
 from scipy.special import logsumexp
 
 from skmotion.tree._beam import decode_searches
 from skmotion.tree._viterbi import kbest_viterbi
+from skmotion.utils._validation import check_int
 
 __all__ = ["NODE_PRIORS", "beam_decode", "exhaustive_viterbi", "node_log_posterior"]
 
@@ -310,8 +309,7 @@ def beam_decode(
     ([[0, 0, 1, 1]], (1, 1, 1))
     """
     layer = tree.check_layer(layer)
-    if not isinstance(score_layers, Integral) or isinstance(score_layers, bool) or score_layers < 1:
-        raise ValueError(f"score_layers must be an int >= 1; got {score_layers!r}.")
+    score_layers = check_int("score_layers", score_layers)
     if prune and guide is None:
         raise ValueError(
             "prune needs a guide: the problems of a clip are compared within the clip's shared search."

@@ -12,19 +12,11 @@ import numpy as np
 from skmotion.tree._build import build_nodes
 from skmotion.tree._gaussian import COVARIANCE_TYPES, Gaussians
 from skmotion.tree._split import SPLIT_CRITERIA
+from skmotion.utils._validation import check_int
 
 __all__ = ["MotionTree"]
 
 _ROUTE_CHUNK = 1 << 16
-
-
-def _check_int(name, value, low, allow_none=False):
-    if allow_none and value is None:
-        return
-    if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
-        raise ValueError(
-            f"{name} must be an int >= {low}{' or None' if allow_none else ''}; got {value!r}."
-        )
 
 
 class MotionTree:
@@ -173,9 +165,9 @@ class MotionTree:
             raise ValueError(
                 f"frames must be finite; frame {frame}, channel {channel} is {X[frame, channel]}."
             )
-        _check_int("max_depth", max_depth, 0, allow_none=True)
-        _check_int("min_samples_split", min_samples_split, 2)
-        _check_int("min_samples_leaf", min_samples_leaf, 1)
+        check_int("max_depth", max_depth, 0, allow_none=True)
+        check_int("min_samples_split", min_samples_split, 2)
+        check_int("min_samples_leaf", min_samples_leaf, 1)
         if split not in SPLIT_CRITERIA:
             raise ValueError(f"split must be one of {SPLIT_CRITERIA}; got {split!r}.")
         if covariance_type not in COVARIANCE_TYPES:
