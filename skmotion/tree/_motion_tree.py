@@ -9,6 +9,7 @@ from numbers import Integral, Real
 
 import numpy as np
 
+from skmotion.base import VersionedStateMixin
 from skmotion.tree._build import build_nodes
 from skmotion.tree._gaussian import COVARIANCE_TYPES, Gaussians
 from skmotion.tree._split import SPLIT_CRITERIA
@@ -19,7 +20,7 @@ __all__ = ["MotionTree"]
 _ROUTE_CHUNK = 1 << 16
 
 
-class MotionTree:
+class MotionTree(VersionedStateMixin):
     """A binary tree of frame clusters; every layer partitions all frames.
 
     Build one with :meth:`build`. Nodes are numbered in creation order
@@ -62,6 +63,11 @@ class MotionTree:
         The variance added to every covariance's diagonal.
     principal_axes : ndarray of shape (n_axes, n_channels)
         The first (up to three) principal axes of all frames, to draw nodes.
+
+    Notes
+    -----
+    A pickle records the skmotion version; loading it into an incompatible
+    version raises :class:`~skmotion.base.IncompatibleVersionError`.
 
     Examples
     --------

@@ -22,6 +22,8 @@ from numbers import Real
 import numpy as np
 import scipy.sparse as sp
 
+from skmotion.base import VersionedStateMixin
+
 __all__ = ["TransitionGraphs"]
 
 # Graphs whose dense table (n_graphs * K * K) is at most this many entries keep
@@ -33,7 +35,7 @@ _DENSE_LIMIT = 1 << 21
 _KERNEL_DENSE_LIMIT = 1 << 20
 
 
-class TransitionGraphs:
+class TransitionGraphs(VersionedStateMixin):
     """Transition counts of one or more graphs at every layer of a motion tree.
 
     Build with :meth:`count`. Graph ``g`` is the graph of the clips assigned to
@@ -53,6 +55,11 @@ class TransitionGraphs:
     n_graphs : int
     n_layers : int
     smoothing : float
+
+    Notes
+    -----
+    A pickle records the skmotion version; loading it into an incompatible
+    version raises :class:`~skmotion.base.IncompatibleVersionError`.
 
     Examples
     --------
