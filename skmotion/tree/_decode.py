@@ -20,6 +20,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from skmotion.tree._beam import decode_searches
+from skmotion.tree._layout import children_table, gaussian_arrays, transition_table
 from skmotion.tree._viterbi import kbest_viterbi
 from skmotion.utils._validation import check_int
 
@@ -142,54 +143,30 @@ _ALL_NODES = np.zeros((0, 0), dtype=np.uint8)
 
 
 def _kernel_allowed(graphs, layer, node_prior):
-    """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``, or ``(0, 0)`` for every node."""
+    """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``, or ``(0, 0)`` for all."""
     if node_prior == "layer":
         return _ALL_NODES
     return np.ascontiguousarray(_allowed_nodes(graphs, layer, node_prior), dtype=np.uint8)
 
 
 def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
-    """What the compiled decoder reads of layers ``1 .. layer`` (entry 0 unused); see ``decode_searches``."""
+    """What the compiled decoder reads of layers ``1 .. layer`` (entry 0 unused).
+
+    See ``decode_searches``; the per-object arrays come from :mod:`skmotion.tree._layout`.
+    """
     specs = [None]
     for depth in range(1, layer + 1):
         specs.append(
             (
-                tree.kernel_children(depth - 1),
+                children_table(tree, depth - 1),
                 tree.node_ids(depth),
-                search.kernel_table(depth),
-                scored.kernel_table(depth),
+                transition_table(search, depth),
+                transition_table(scored, depth),
                 _kernel_allowed(search, depth, node_prior),
                 _kernel_allowed(scored, depth, node_prior) if mask_scored else _ALL_NODES,
             )
         )
     return specs
-
-
-def _descend(tree, graphs, frames, frame_start, n_steps, graph, *, layer, n_paths, node_prior):
-    """Each frame's ``n_paths`` best nodes at ``layer``, ``(sum(n_steps), width)``; -1 for none.
-
-    Search ``s`` decodes ``n_steps[s]`` frames from ``frame_start[s]`` under
-    graph ``graph[s]``; its rows follow those of the searches before it.
-    """
-    n_steps = np.asarray(n_steps, dtype=np.intp)
-    if layer == 0:
-        return np.zeros((int(n_steps.sum()), 1), dtype=np.intp)
-    specs = _layer_specs(tree, graphs, graphs, layer, node_prior, False)
-    _, _, beam = decode_searches(
-        np.ascontiguousarray(frames, dtype=np.float64),
-        np.asarray(frame_start, dtype=np.intp),
-        n_steps,
-        np.asarray(graph, dtype=np.intp),
-        np.zeros(len(n_steps) + 1, dtype=np.intp),
-        np.zeros(0, dtype=np.intp),
-        tree.kernel_gaussians(),
-        specs,
-        1,
-        n_paths,
-        "beam",
-        False,
-    )
-    return beam
 
 
 def _clip_normalisers(tree, graphs, frames, offsets, clips, layers, node_prior):
@@ -355,14 +332,14 @@ def beam_decode(
         if prune and n_paths > 1
         else "kbest"
     )
-    scores, paths, _ = decode_searches(
+    scores, paths = decode_searches(
         frames,
         offsets[search_clip],
         lengths[search_clip],
         search_graph,
         problem_start,
         score_graph,
-        tree.kernel_gaussians(),
+        gaussian_arrays(tree),
         specs,
         first,
         n_paths,

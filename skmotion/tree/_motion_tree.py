@@ -115,9 +115,6 @@ class MotionTree(VersionedStateMixin):
         self.principal_axes = principal_axes
         self.low_rank = [None] * len(parent) if low_rank is None else low_rank
         self._gaussians = Gaussians(mean, covariance, covariance_type, self.low_rank)
-        self._kernel_children = [
-            np.ascontiguousarray(self.children(layer)) for layer in range(len(layers))
-        ]
 
     @classmethod
     def build(
@@ -349,13 +346,10 @@ class MotionTree(VersionedStateMixin):
             ids = ids[np.asarray(nodes, dtype=np.intp)]
         return self._gaussians.log_pdf(self._check_frames(frames), ids)
 
-    def kernel_gaussians(self):
-        """The nodes' Gaussians as the compiled decoder reads them (see ``Gaussians.kernel_arrays``)."""
-        return self._gaussians.kernel_arrays()
-
-    def kernel_children(self, layer):
-        """``children(layer)`` as the compiled decoder reads it: made once, C-contiguous."""
-        return self._kernel_children[self.check_layer(layer)]
+    @property
+    def gaussians(self):
+        """The nodes' Gaussians (tree node id order), which give ``log_likelihood``."""
+        return self._gaussians
 
     def _check_frames(self, frames):
         X = np.asarray(frames, dtype=np.float64)

@@ -11,8 +11,10 @@ from skmotion.tree import (
     TransitionGraphs,
     beam_decode,
     exhaustive_viterbi,
+    kbest_viterbi,
     node_log_posterior,
 )
+from skmotion.tree._layout import gaussian_arrays, transition_table
 
 
 @pytest.fixture(scope="module")
@@ -116,7 +118,7 @@ def test_the_compiled_decoder_agrees_for_every_covariance_and_table(
         graph_of_clip=[0, 1],
         smoothing=0.5,
     )
-    assert (len(graphs.kernel_table(1)["dense"]) > 0) == dense
+    assert (len(transition_table(graphs, 1)["dense"]) > 0) == dense
     clip = frames[[2, 33, 61, 80, 14]] + 0.3
     wide = int(tree.n_nodes.max())
     for graph in (0, 1):
@@ -161,29 +163,49 @@ def reference_beams(tree, graphs, clip, graph, n_paths, layer):
     return beam
 
 
+def reference_kbest_on_beams(tree, graphs, clip, graph, n_paths, layer):
+    """The numpy K-best Viterbi over the candidates the reference beams leave at ``layer``."""
+    beam = reference_beams(tree, graphs, clip, graph, n_paths, layer - 1)
+    kids = tree.children(layer - 1)
+    cand = np.array(
+        [[kids[n, side] if n >= 0 else -1 for side in (0, 1) for n in row] for row in beam]
+    )
+    log_ps = node_log_posterior(tree, graphs, layer, clip, "layer")[graph]
+    emit = np.where(cand >= 0, log_ps[np.arange(len(clip))[:, None], cand], -np.inf)
+    moves = graphs.log_prob(layer, graph, cand[:-1, :, None], cand[1:, None, :])
+    slots, scores = kbest_viterbi(emit[0][:, None], (moves + emit[1:, None, :])[..., None], n_paths)
+    paths = np.where(slots[0] >= 0, np.take_along_axis(cand.T, np.maximum(slots[0], 0), 0), -1)
+    return paths, scores[0]
+
+
 @pytest.mark.parametrize("n_paths", [1, 2, 3])
 def test_the_compiled_beams_follow_their_definition(model, n_paths):
-    from skmotion.tree._decode import _descend
+    """At each layer, the sequences decoded are the K best over the children of the beams above.
 
+    The beams are built from their definition (``reference_beams``), so a
+    wrong beam at any layer shows in the sequences or their scores.
+    """
     tree, graphs, frames = model
     rng = np.random.default_rng(n_paths)
     clip = frames[rng.integers(0, 100, size=12)] + rng.normal(scale=0.5, size=(12, 2))
     for graph in (0, 1):
         for layer in range(1, tree.n_layers):
-            beam = _descend(
+            paths, scores = beam_decode(
                 tree,
                 graphs,
                 clip,
-                np.array([0]),
-                np.array([12]),
-                np.array([graph]),
+                [0, 12],
+                [0],
+                [graph],
                 layer=layer,
                 n_paths=n_paths,
                 node_prior="layer",
             )
-            np.testing.assert_array_equal(
-                beam, reference_beams(tree, graphs, clip, graph, n_paths, layer)
+            ref_paths, ref_scores = reference_kbest_on_beams(
+                tree, graphs, clip, graph, n_paths, layer
             )
+            np.testing.assert_allclose(scores[0, 0], ref_scores, rtol=1e-12)
+            np.testing.assert_array_equal(paths[0], ref_paths)
 
 
 @pytest.mark.parametrize("n_paths", [1, 2, 3])
@@ -444,7 +466,7 @@ def test_low_rank_covariances_decode_as_the_full_factor():
     tree = MotionTree.build(
         frames, max_depth=3, min_samples_leaf=4, split="median", covariance_type="full"
     )
-    low = tree.kernel_gaussians()["lr_start"] >= 0
+    low = gaussian_arrays(tree)["lr_start"] >= 0
     assert low.any() and not low.all()  # both forms are exercised
     graphs = TransitionGraphs.count(
         list(tree.iter_apply(frames)),
