@@ -215,16 +215,11 @@ def plan_motion(
     *,
     frame_rate,
     body_size,
-    max_frames,
-    tolerance,
     start_node=None,
     model=None,
-    heuristic_weight=8.0,
-    cell=0.05,
-    heading_bins=36,
-    max_expansions=500_000,
     damping=1e-3,
     layer=-1,
+    **search,
 ):
     """Plan a motion on one layer of a motion database; see :meth:`MotionTreeHMM.plan`.
 
@@ -239,11 +234,17 @@ def plan_motion(
         Frames per node (the start prior).
     start : tuple of (float, float, float)
     goal : tuple of (float, float)
-    frame_rate, body_size, max_frames, tolerance : float, float, int, float
+    frame_rate, body_size : float
     start_node : int, default=None
     model : SkeletonModel, default=None
-    heuristic_weight, cell, heading_bins, max_expansions, damping, layer
-        See :func:`astar_search` and :func:`node_root_velocity`.
+    damping : float, default=1e-3
+        See :func:`node_root_velocity`.
+    layer : int, default=-1
+        Recorded in the plan.
+    **search
+        The keywords of :func:`astar_search`: ``tolerance`` and ``max_frames``
+        (required), ``heuristic_weight``, ``cell``, ``heading_bins``,
+        ``max_expansions``, ``dwell_span``.
 
     Returns
     -------
@@ -266,21 +267,7 @@ def plan_motion(
         start_costs = np.full(len(means), np.inf)
         start_costs[start_node] = 0.0
     began = time.perf_counter()
-    result = astar_search(
-        indptr,
-        indices,
-        costs,
-        steps,
-        start_costs,
-        start,
-        goal,
-        tolerance=tolerance,
-        max_frames=max_frames,
-        heuristic_weight=heuristic_weight,
-        cell=cell,
-        heading_bins=heading_bins,
-        max_expansions=max_expansions,
-    )
+    result = astar_search(indptr, indices, costs, steps, start_costs, start, goal, **search)
     search_seconds = time.perf_counter() - began
     nodes = result.nodes
     path_counts = np.asarray(counts[nodes[:-1], nodes[1:]]).ravel()

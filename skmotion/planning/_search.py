@@ -18,6 +18,7 @@ Poses are merged into cells (``cell`` metres, ``heading_bins`` headings) per
 node, the first (cheapest) arrival keeping its exact pose, as in hybrid A*.
 """
 
+import functools
 import heapq
 import math
 from dataclasses import dataclass
@@ -146,51 +147,78 @@ class _LowerBound:
         return np.where(d <= self.tol, 0, np.ceil((d - self.tol) / self.s_max - 1e-12))
 
     def cost(self, d, frames):
-        """The weighted lower bound at distance ``d``, which needs ``frames`` more frames."""
-        with np.errstate(invalid="ignore"):  # inf * 0 in the branch np.where drops
-            bound = self.w * np.maximum(self.c_min * frames, self.r * (d - self.tol))
+        """The weighted lower bound at distance ``d``, which needs ``frames`` more frames.
+
+        Called where some transition is seen (``c_min`` finite) or ``d > tol``.
+        """
+        bound = self.w * np.maximum(self.c_min * frames, self.r * (d - self.tol))
         return np.where(d <= self.tol, 0.0, bound)
 
 
 class _Entry(NamedTuple):
-    """A search entry: the path enters graph ``node`` at ``frame`` with ``pose`` and ``cost``.
+    """A search entry: the path enters graph ``node`` at ``frame``, pose ``(x, y, h)``, ``cost``.
 
-    ``node`` -1 is a path that ends at the goal inside its parent's dwell.
+    Entries order as tuples: by ``priority`` (the cost plus the lower bound
+    still to go), ties to the lower ``index`` (the order they were made in).
+    ``node`` -1 is a path that ends at the goal inside its parent's dwell;
     ``dwell`` is how many frames the parent stayed in its node before this entry.
     """
 
+    priority: float
+    index: int
     node: int
-    pose: tuple
+    x: float
+    y: float
+    h: float
     parent: int
     frame: int
     cost: float
     dwell: int
 
+    @property
+    def pose(self):
+        return self.x, self.y, self.h
+
+
+# An entry kept as a plain tuple, handed out as an _Entry (C-level, unlike _Entry's own __new__).
+_as_entry = functools.partial(tuple.__new__, _Entry)
+
 
 class _OpenSet:
-    """Every entry made, and a heap of the open ones: least priority first, ties to the earliest."""
+    """Every entry made (by index), and a heap of the open ones, the least first.
+
+    Entries are stored as plain tuples in :class:`_Entry`'s field order and
+    handed out as :class:`_Entry`: the garbage collector stops tracking a plain
+    tuple of numbers (never a tuple subclass), which keeps its passes short
+    however many entries a search makes.
+    """
 
     def __init__(self):
-        self.entries = []
+        self._entries = []
         self._heap = []
 
     def __bool__(self):
         return bool(self._heap)
 
-    def push(self, entry, priority):
-        self.entries.append(entry)
-        heapq.heappush(self._heap, (priority, len(self.entries) - 1))
-        return len(self.entries) - 1
+    def push(self, priority, node, pose, parent, frame, cost, dwell):
+        """Make an entry and open it; returns its index."""
+        entry = (priority, len(self._entries), node, *pose, parent, frame, cost, dwell)
+        self._entries.append(entry)
+        heapq.heappush(self._heap, entry)
+        return entry[1]
 
     def pop(self):
-        _, i = heapq.heappop(self._heap)
-        return i, self.entries[i]
+        """The open entry of the least priority, closed."""
+        return _as_entry(heapq.heappop(self._heap))
+
+    def entry(self, i):
+        return _as_entry(self._entries[i])
 
     def chain(self, i):
         """The entries from a start to entry ``i``."""
         out = []
         while i >= 0:
-            out.append(self.entries[i])
+            out.append(self.entry(i))
             i = out[-1].parent
         return out[::-1]
 
@@ -223,14 +251,16 @@ class _Search:
 
     def run(self, max_expansions):
         """The index of the entry that ends the path found, or -1."""
+        pop, best, cell_of = self.open.pop, self.best, self.key  # local names: the hot loop
         while self.open:
-            i, entry = self.open.pop()
-            if entry.node < 0:
+            entry = pop()
+            _, i, node, x, y, h, _, _, cost, _ = entry
+            if node < 0:
                 return i
-            key = self.key(entry.node, *entry.pose)
-            if self.best.get(key, math.inf) < entry.cost:
+            key = cell_of(node, x, y, h)
+            if best.get(key, math.inf) < cost:
                 continue
-            self.best[key] = entry.cost
+            best[key] = cost
             self.expansions += 1
             if self.expansions > max_expansions:
                 # Out of budget: the cheapest path found so far that ends at the goal, if any
@@ -254,13 +284,9 @@ class _Search:
         if len(at_goal):
             j = int(at_goal[0])  # end at frame t + j, after j self-loops
             cost = entry.cost + j * loop
-            end = self.open.push(
-                _Entry(
-                    -1, (float(x[j]), float(y[j]), float(h[j])), i, entry.frame + j, cost, j + 1
-                ),
-                cost,
-            )
-            if self.fallback < 0 or cost < self.open.entries[self.fallback].cost:
+            pose = (float(x[j]), float(y[j]), float(h[j]))
+            end = self.open.push(cost, -1, pose, i, entry.frame + j, cost, j + 1)
+            if self.fallback < 0 or cost < self.open.entry(self.fallback).cost:
                 self.fallback = end
         self.push_moves(i, entry, loop, (x[1:], y[1:], h[1:]), dist[1:])
 
@@ -279,15 +305,17 @@ class _Search:
         fresh[1:] = (np.diff(ix) != 0) | (np.diff(iy) != 0) | (np.diff(ih) != 0)
         ok = ok[fresh[ok]]
         ix, iy, ih, lower = ix.tolist(), iy.tolist(), ih.tolist(), lower.tolist()
+        x, y, h = poses
+        best_get, push = self.best.get, self.open.push  # local names: the hot loop
         for j in ok.tolist():
-            base, pose = entry.cost + j * loop, None
+            base, pose, frame = entry.cost + j * loop, None, entry.frame + j + 1
             for m, cost in moves:
                 g = base + cost
-                if self.best.get((m, ix[j], iy[j], ih[j]), math.inf) <= g:
+                if best_get((m, ix[j], iy[j], ih[j]), math.inf) <= g:
                     continue
                 if pose is None:
-                    pose = tuple(float(v[j]) for v in poses)
-                self.open.push(_Entry(m, pose, i, entry.frame + j + 1, g, j + 1), g + lower[j])
+                    pose = (float(x[j]), float(y[j]), float(h[j]))
+                push(g + lower[j], m, pose, i, frame, g, j + 1)
 
     def result(self, found):
         """The path that ends at entry ``found``, frame by frame."""
@@ -390,12 +418,10 @@ def astar_search(
         heading_bins=heading_bins,
         closest=d0,
     )
-    start_bound = float(bound.cost(d0, bound.frames(d0)))
+    start_bound = 0.0 if d0 <= bound.tol else float(bound.cost(d0, bound.frames(d0)))
     for n in np.flatnonzero(np.isfinite(start_costs)):
         cost = float(start_costs[n])
-        search.open.push(
-            _Entry(int(n), tuple(map(float, start)), -1, 0, cost, 0), cost + start_bound
-        )
+        search.open.push(cost + start_bound, int(n), tuple(map(float, start)), -1, 0, cost, 0)
     found = search.run(max_expansions)
     if found < 0:
         why = (
