@@ -25,7 +25,7 @@ def _check_point(name, value, size, what):
 
 
 def _skeleton_model(database, transformer):
-    """The transformer's :class:`SkeletonModel` (None without a skeleton), checked against the model."""
+    """The transformer's :class:`SkeletonModel` (None without a skeleton), checked."""
     if database.n_features_in_ % 6:
         raise ValueError(
             "plan needs virtual-marker clips, 6 channels (px, py, pz, vx, vy, vz) per marker; "
@@ -78,7 +78,7 @@ def plan_from_database(
     heading_bins=36,
     max_expansions=500_000,
 ):
-    """Plan a motion on a motion database's global graph that takes the root from ``start`` to ``goal``.
+    """Plan a motion on a database's global graph that takes the root from ``start`` to ``goal``.
 
     A* over (node, root pose on the floor) finds the most probable node
     path (minimum ``-log P(path)``, the start node's frequency times the

@@ -62,7 +62,10 @@ class SkeletonModel:
         return cls(skeleton, markers, root, left, right, size)
 
     def solve(self, body_positions):
-        """Channels whose markers fit body-frame positions ``(n, n_markers, 3)``, and the RMS error (data units)."""
+        """Channels whose markers fit body-frame positions ``(n, n_markers, 3)``; the RMS error.
+
+        The error is in data units.
+        """
         targets = body_positions * self.units_per_size @ plan_axes(self.skeleton.up_axis).T
         q0 = facing_pose(
             self.skeleton, self.markers, targets, root=self.root, left=self.left, right=self.right
@@ -163,7 +166,10 @@ class MotionPlan:
         return float(np.hypot(*(self.root[-1, :2] - self.goal)))
 
     def marker_positions(self):
-        """World marker positions of the frames on the planning floor, ``(n_frames, n_markers, 3)`` metres."""
+        """World marker positions of the frames on the planning floor, metres.
+
+        Shape ``(n_frames, n_markers, 3)``.
+        """
         local = self.frames.reshape(self.n_frames, -1, 6)[..., :3] * self.body_size
         turn = yaw_matrix(self.root[:, 2], "z")
         out = np.einsum("fij,fmj->fmi", turn, local)

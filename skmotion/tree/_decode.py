@@ -35,7 +35,7 @@ _UNDERFLOW = 1e-200
 
 
 def _log_normaliser(log_po, allowed):
-    """``log sum_{j allowed in g} Po(x | j)`` for every frame and graph, ``(n_frames, n_graphs)``."""
+    """``log sum_{j allowed in g} Po(x | j)`` of every frame and graph, ``(n_frames, n_graphs)``."""
     top = log_po.max(axis=1, keepdims=True)
     weights = np.exp(log_po - top) @ allowed.T.astype(np.float64)
     with np.errstate(divide="ignore"):
@@ -143,7 +143,7 @@ _ALL_NODES = np.zeros((0, 0), dtype=np.uint8)
 
 
 def _kernel_allowed(graphs, layer, node_prior):
-    """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``, or ``(0, 0)`` for all."""
+    """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``; ``(0, 0)``: all."""
     if node_prior == "layer":
         return _ALL_NODES
     return np.ascontiguousarray(_allowed_nodes(graphs, layer, node_prior), dtype=np.uint8)
@@ -170,7 +170,9 @@ def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
 
 
 def _clip_normalisers(tree, graphs, frames, offsets, clips, layers, node_prior):
-    """``sum_t log sum_j Po(x_t | j) P(j)`` of each clip, per layer and graph column: ``(n_layers, n_clips, n_cols)``.
+    """``sum_t log sum_j Po(x_t | j) P(j)`` of each clip, per layer and graph column.
+
+    Shape ``(n_layers, n_clips, n_cols)``.
 
     Only the frames of ``clips`` are evaluated.
     """
@@ -257,7 +259,8 @@ def beam_decode(
         sequences lies between the best one and ``n_paths`` times it, so a
         problem whose best sequences (summed over the scored layers) score
         more than ``n_scored log(n_paths)`` below those of another problem of
-        the same clip can never win; it gets ``-inf`` scores and -1 paths. A clip left with one problem has its winner: that problem gets
+        the same clip can never win; it gets ``-inf`` scores and -1 paths. A
+        clip left with one problem has its winner: that problem gets
         only its best sequences' scores (the others ``-inf``) and -1 paths.
         Which problem wins is unchanged.
     return_paths : bool, default=True
@@ -281,7 +284,8 @@ def beam_decode(
     >>> tree = MotionTree.build(frames, min_samples_leaf=10, max_depth=1)
     >>> graphs = TransitionGraphs.count(tree.iter_apply(frames), tree.n_nodes, offsets=[0, 40],
     ...                                 graph_of_clip=[0])
-    >>> paths, scores = beam_decode(tree, graphs, frames[18:22], [0, 4], [0], [0], layer=1, n_paths=1)
+    >>> paths, scores = beam_decode(tree, graphs, frames[18:22], [0, 4], [0], [0], layer=1,
+    ...                             n_paths=1)
     >>> paths[0].tolist(), scores.shape
     ([[0, 0, 1, 1]], (1, 1, 1))
     """
@@ -289,7 +293,8 @@ def beam_decode(
     score_layers = check_int("score_layers", score_layers)
     if prune and guide is None:
         raise ValueError(
-            "prune needs a guide: the problems of a clip are compared within the clip's shared search."
+            "prune needs a guide: the problems of a clip are compared within the clip's "
+            "shared search."
         )
     offsets = np.asarray(offsets, dtype=np.intp)
     clip_of_problem = np.asarray(clip_of_problem, dtype=np.intp)

@@ -531,7 +531,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         )
 
     def plan(self, start, goal, *, frame_rate, **options):
-        """Plan a motion on the global transition graph that takes the root from ``start`` to ``goal``.
+        """Plan a motion on the global graph that takes the root from ``start`` to ``goal``.
 
         A* over (node, root pose on the floor) finds the most probable node
         path whose root ends near the goal, using only transitions seen in the

@@ -1,4 +1,4 @@
-"""The compiled decoder's view of a motion tree and its graphs: contiguous arrays made once per object.
+"""The compiled decoder's view of a motion tree and its graphs: arrays made once per object.
 
 :mod:`skmotion.tree._beam` reads plain C arrays. This module lays a
 :class:`MotionTree`'s Gaussians and children and a :class:`TransitionGraphs`'
@@ -22,7 +22,7 @@ _CACHE = weakref.WeakKeyDictionary()
 
 
 def _cached(owner, key, make):
-    """``make()`` once per owner and key (two threads may both make it; either result is the same)."""
+    """``make()`` once per owner and key (two threads may both make it: the results are equal)."""
     made = _CACHE.setdefault(owner, {})
     if key not in made:
         made[key] = make()

@@ -1,4 +1,4 @@
-"""The one integer check for arguments of functions that sklearn's parameter validation does not cover."""
+"""The one integer check, for arguments that sklearn's parameter validation does not cover."""
 
 from numbers import Integral
 
