@@ -56,6 +56,14 @@ def _per_query_counts(candidates, y_query, y_stored, query_ids):
     return counts
 
 
+def _mean_share(part, whole):
+    """Mean over queries of ``part / whole``, leaving out those whose ``whole`` is 0; NaN if all."""
+    defined = whole > 0
+    if not defined.any():
+        return float("nan")
+    return float(np.mean(part[defined] / whole[defined]))
+
+
 _METRIC_PARAMS = {
     "candidates": [list, tuple],
     "y_query": ["array-like"],
@@ -102,11 +110,7 @@ def pruning_efficiency(candidates, y_query, y_stored, *, query_ids=None):
     0.666...
     """
     counts = _per_query_counts(candidates, y_query, y_stored, query_ids)
-    defined = counts[:, 3] > 0
-    if not defined.any():
-        return float("nan")
-    pruned = counts[defined, 3] - counts[defined, 2]
-    return float(np.mean(pruned / counts[defined, 3]))
+    return _mean_share(counts[:, 3] - counts[:, 2], counts[:, 3])
 
 
 @validate_params(_METRIC_PARAMS, prefer_skip_nested_validation=True)
@@ -147,10 +151,7 @@ def recall(candidates, y_query, y_stored, *, query_ids=None):
     1.0
     """
     counts = _per_query_counts(candidates, y_query, y_stored, query_ids)
-    defined = counts[:, 1] > 0
-    if not defined.any():
-        return float("nan")
-    return float(np.mean(counts[defined, 0] / counts[defined, 1]))
+    return _mean_share(counts[:, 0], counts[:, 1])
 
 
 def _index_and_queries(estimator, X):
