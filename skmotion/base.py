@@ -116,11 +116,14 @@ class VersionedStateMixin:
     its fitted state holds its own data structures (motion trees, interval
     indexes, transition graphs) whose layout may change between minor versions,
     and loading an old layout would give wrong results or fail far from the cause.
-    Every clip estimator gets this through :class:`ClipEstimatorMixin`.
+    Every clip estimator gets this through :class:`ClipEstimatorMixin`; the
+    data structures of fitted state (``MotionTree``, ``TransitionGraphs``)
+    derive from it directly.
     """
 
     def __getstate__(self):
-        state = super().__getstate__()
+        parent = getattr(super(), "__getstate__", None)  # object has none before Python 3.11
+        state = parent() if parent is not None else self.__dict__
         return dict(state, **{_VERSION_KEY: _running_version()})
 
     def __setstate__(self, state):
@@ -134,7 +137,11 @@ class VersionedStateMixin:
                 f"version. Load it with skmotion {saved or '(the saving version)'} installed, or "
                 f"refit it with skmotion {running}."
             )
-        super().__setstate__(state)
+        parent = getattr(super(), "__setstate__", None)
+        if parent is None:  # a plain object: its state is its __dict__
+            self.__dict__.update(state)
+        else:
+            parent(state)
 
 
 class ClipEstimatorMixin(VersionedStateMixin):

@@ -8,9 +8,10 @@ from numbers import Real
 
 import numpy as np
 
-from skmotion.utils._sklearn_compat import Interval, validate_params
+from skmotion.utils._sklearn_compat import Interval, StrOptions, validate_params
 
 __all__ = [
+    "SEARCH_SCORES",
     "make_pruning_scorer",
     "make_search_scorer",
     "pruning_efficiency",
@@ -53,6 +54,14 @@ def _per_query_counts(candidates, y_query, y_stored, query_ids):
             n_stored - stored_relevant,
         )
     return counts
+
+
+def _mean_share(part, whole):
+    """Mean over queries of ``part / whole``, leaving out those whose ``whole`` is 0; NaN if all."""
+    defined = whole > 0
+    if not defined.any():
+        return float("nan")
+    return float(np.mean(part[defined] / whole[defined]))
 
 
 _METRIC_PARAMS = {
@@ -101,11 +110,7 @@ def pruning_efficiency(candidates, y_query, y_stored, *, query_ids=None):
     0.666...
     """
     counts = _per_query_counts(candidates, y_query, y_stored, query_ids)
-    defined = counts[:, 3] > 0
-    if not defined.any():
-        return float("nan")
-    pruned = counts[defined, 3] - counts[defined, 2]
-    return float(np.mean(pruned / counts[defined, 3]))
+    return _mean_share(counts[:, 3] - counts[:, 2], counts[:, 3])
 
 
 @validate_params(_METRIC_PARAMS, prefer_skip_nested_validation=True)
@@ -146,10 +151,7 @@ def recall(candidates, y_query, y_stored, *, query_ids=None):
     1.0
     """
     counts = _per_query_counts(candidates, y_query, y_stored, query_ids)
-    defined = counts[:, 1] > 0
-    if not defined.any():
-        return float("nan")
-    return float(np.mean(counts[defined, 0] / counts[defined, 1]))
+    return _mean_share(counts[:, 0], counts[:, 1])
 
 
 def _index_and_queries(estimator, X):
@@ -172,84 +174,106 @@ def _search_quality(estimator, X, y):
     )
 
 
-def pruning_scorer(estimator, X, y):
-    """Scorer: the pruning efficiency of the fitted index on held-out queries.
-
-    For ``GridSearchCV(scoring=...)``: the validation clips query the index
-    built on the training clips. ``estimator`` is an
-    :class:`~skmotion.neighbors.IntervalIndexNeighbors` or a Pipeline ending in one.
-
-    Parameters
-    ----------
-    estimator : fitted IntervalIndexNeighbors or Pipeline
-    X : clips or feature vectors
-        Queries.
-    y : array-like of shape (n_queries,)
-        Their labels.
-
-    Returns
-    -------
-    score : float
-
-    Examples
-    --------
-    >>> from skmotion.datasets import make_motions
-    >>> from skmotion.metrics import pruning_scorer
-    >>> from skmotion.neighbors import IntervalIndexNeighbors
-    >>> data = make_motions(n_clips_per_class=6, random_state=0)
-    >>> clips = [c[:, 6:] for c in data.clips]
-    >>> index = IntervalIndexNeighbors(n_levels=5).fit(clips[::2], data.target[::2])
-    >>> 0 <= pruning_scorer(index, clips[1::2], data.target[1::2]) <= 1
-    True
-    """
-    return _search_quality(estimator, X, y)[0]
-
-
-def recall_scorer(estimator, X, y):
-    """Scorer: the recall of the fitted index on held-out queries.
-
-    Parameters
-    ----------
-    estimator : fitted IntervalIndexNeighbors or Pipeline
-    X : clips or feature vectors
-        Queries.
-    y : array-like of shape (n_queries,)
-        Their labels.
-
-    Returns
-    -------
-    score : float
-
-    Examples
-    --------
-    >>> from skmotion.datasets import make_motions
-    >>> from skmotion.metrics import recall_scorer
-    >>> from skmotion.neighbors import IntervalIndexNeighbors
-    >>> data = make_motions(n_clips_per_class=6, random_state=0)
-    >>> clips = [c[:, 6:] for c in data.clips]
-    >>> index = IntervalIndexNeighbors(n_levels=5).fit(clips[::2], data.target[::2])
-    >>> 0 <= recall_scorer(index, clips[1::2], data.target[1::2]) <= 1
-    True
-    """
-    return _search_quality(estimator, X, y)[1]
-
-
 def _bounded(pruning, found, min_recall):
     """Pruning efficiency while recall >= min_recall, else recall - 1 (negative)."""
     return pruning if found >= min_recall else found - 1.0
 
 
-class _PruningAtRecall:
-    """Pruning efficiency while recall >= min_recall, else recall - 1 (negative)."""
+#: What a search scorer returns: one score, or ``"all"`` of them as a dict.
+SEARCH_SCORES = ("all", "pruning", "recall", "pruning_at_recall")
 
-    def __init__(self, min_recall):
+
+class _SearchScorer:
+    """Pruning, recall and bounded pruning from one query pass: one of them, or all as a dict."""
+
+    def __init__(self, min_recall, score):
         self.min_recall = min_recall
+        self.score = score
 
     def __call__(self, estimator, X, y):
-        return _bounded(*_search_quality(estimator, X, y), self.min_recall)
+        pruning, found = _search_quality(estimator, X, y)
+        scores = {
+            "pruning": pruning,
+            "recall": found,
+            "pruning_at_recall": _bounded(pruning, found, self.min_recall),
+        }
+        return scores if self.score == "all" else scores[self.score]
 
     def __repr__(self):
-        return f"make_pruning_scorer(min_recall={self.min_recall!r})"
+        return f"make_search_scorer(min_recall={self.min_recall!r}, score={self.score!r})"
+
+
+@validate_params(
+    {
+        "min_recall": [Interval(Real, 0, 1, closed="both")],
+        "score": [StrOptions(set(SEARCH_SCORES))],
+    },
+    prefer_skip_nested_validation=True,
+)
+def make_search_scorer(min_recall=0.99, *, score="all"):
+    """A scorer of similarity search on held-out queries, for ``GridSearchCV(scoring=...)``.
+
+    The validation clips query the index built on the training clips
+    (``estimator`` is an :class:`~skmotion.neighbors.IntervalIndexNeighbors`
+    or a Pipeline ending in one). The scores are the pruning efficiency, the
+    recall, and the *bounded* pruning: the pruning efficiency while recall
+    ``>= min_recall``, else ``recall - 1`` (negative), so that any setting
+    that keeps the recall beats every setting that does not, and among those
+    that do not, the higher recall wins.
+
+    ``GridSearchCV`` calls each scorer of a ``scoring`` dict on its own, so
+    three scorers side by side query the index (and run any transformer
+    before it) three times. With ``score="all"`` the scorer queries once and
+    returns the three scores as a dict, which ``GridSearchCV(scoring=...)``
+    accepts: ``refit="pruning_at_recall"`` refits the best bounded setting.
+
+    Parameters
+    ----------
+    min_recall : float, default=0.99
+        The recall bound of ``"pruning_at_recall"``.
+    score : {"all", "pruning", "recall", "pruning_at_recall"}, default="all"
+        The score the scorer returns, or ``"all"`` for the dict of them.
+
+    Returns
+    -------
+    scorer : callable
+        ``scorer(estimator, X, y)``: a float, or with ``score="all"``
+        ``{"pruning": ..., "recall": ..., "pruning_at_recall": ...}``.
+
+    See Also
+    --------
+    pruning_scorer, recall_scorer : ``make_search_scorer(score="pruning")``
+        and ``make_search_scorer(score="recall")``.
+    make_pruning_scorer : ``make_search_scorer(min_recall, score="pruning_at_recall")``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.datasets import make_repeated_motions
+    >>> from skmotion.metrics import make_search_scorer, pruning_scorer
+    >>> from skmotion.neighbors import IntervalIndexNeighbors
+    >>> data = make_repeated_motions(n_motions_per_class=2, n_repeats=4, random_state=0)
+    >>> query = [k % 4 == 0 for k in range(len(data.clips))]  # one repetition of each motion
+    >>> stored = [c for c, q in zip(data.clips, query) if not q]
+    >>> queries = [c for c, q in zip(data.clips, query) if q]
+    >>> index = IntervalIndexNeighbors(n_levels=5).fit(stored, data.target[~np.array(query)])
+    >>> scores = make_search_scorer(0.9)(index, queries, data.target[query])
+    >>> sorted(scores), scores["recall"] >= 0.9
+    (['pruning', 'pruning_at_recall', 'recall'], True)
+    >>> pruning_scorer(index, queries, data.target[query]) == scores["pruning"]
+    True
+
+    In a grid search: ``GridSearchCV(index, grid, scoring=make_search_scorer(0.9),
+    refit="pruning_at_recall")``.
+    """
+    return _SearchScorer(min_recall, score)
+
+
+#: Scorer: the pruning efficiency of the fitted index on held-out queries.
+pruning_scorer = _SearchScorer(0.99, "pruning")
+
+#: Scorer: the recall of the fitted index on held-out queries.
+recall_scorer = _SearchScorer(0.99, "recall")
 
 
 @validate_params(
@@ -258,9 +282,8 @@ class _PruningAtRecall:
 def make_pruning_scorer(min_recall=0.99):
     """A scorer that rewards pruning only while recall stays at or above a bound.
 
-    The score is the pruning efficiency when recall ``>= min_recall``, else
-    ``recall - 1`` (negative). Any setting that keeps the recall beats every
-    setting that does not, and among those that do not, the higher recall wins.
+    ``make_search_scorer(min_recall, score="pruning_at_recall")``: the pruning
+    efficiency when recall ``>= min_recall``, else ``recall - 1`` (negative).
 
     Parameters
     ----------
@@ -287,67 +310,4 @@ def make_pruning_scorer(min_recall=0.99):
     >>> sorted(search.best_params_)
     ['epsilon']
     """
-    return _PruningAtRecall(min_recall)
-
-
-class _SearchScores:
-    """Pruning, recall and bounded pruning from one query pass, as a dict."""
-
-    def __init__(self, min_recall):
-        self.min_recall = min_recall
-
-    def __call__(self, estimator, X, y):
-        pruning, found = _search_quality(estimator, X, y)
-        return {
-            "pruning": pruning,
-            "recall": found,
-            "pruning_at_recall": _bounded(pruning, found, self.min_recall),
-        }
-
-    def __repr__(self):
-        return f"make_search_scorer(min_recall={self.min_recall!r})"
-
-
-@validate_params(
-    {"min_recall": [Interval(Real, 0, 1, closed="both")]}, prefer_skip_nested_validation=True
-)
-def make_search_scorer(min_recall=0.99):
-    """One scorer giving pruning, recall and the bounded pruning together.
-
-    ``GridSearchCV`` calls each scorer of a ``scoring`` dict on its own, so
-    :func:`pruning_scorer`, :func:`recall_scorer` and
-    :func:`make_pruning_scorer` side by side query the index (and run any
-    transformer before it) three times. This scorer queries once and returns
-    the three scores as a dict, which ``GridSearchCV(scoring=...)`` accepts:
-    ``refit="pruning_at_recall"`` refits the best bounded setting.
-
-    Parameters
-    ----------
-    min_recall : float, default=0.99
-        The recall bound of ``"pruning_at_recall"`` (see :func:`make_pruning_scorer`).
-
-    Returns
-    -------
-    scorer : callable
-        ``scorer(estimator, X, y) -> {"pruning": ..., "recall": ...,
-        "pruning_at_recall": ...}``.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from skmotion.datasets import make_repeated_motions
-    >>> from skmotion.metrics import make_search_scorer
-    >>> from skmotion.neighbors import IntervalIndexNeighbors
-    >>> data = make_repeated_motions(n_motions_per_class=2, n_repeats=4, random_state=0)
-    >>> query = [k % 4 == 0 for k in range(len(data.clips))]  # one repetition of each motion
-    >>> stored = [c for c, q in zip(data.clips, query) if not q]
-    >>> queries = [c for c, q in zip(data.clips, query) if q]
-    >>> index = IntervalIndexNeighbors(n_levels=5).fit(stored, data.target[~np.array(query)])
-    >>> scores = make_search_scorer(0.9)(index, queries, data.target[query])
-    >>> sorted(scores), scores["recall"] >= 0.9
-    (['pruning', 'pruning_at_recall', 'recall'], True)
-
-    In a grid search: ``GridSearchCV(index, grid, scoring=make_search_scorer(0.9),
-    refit="pruning_at_recall")``.
-    """
-    return _SearchScores(min_recall)
+    return _SearchScorer(min_recall, "pruning_at_recall")

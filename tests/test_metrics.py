@@ -104,6 +104,10 @@ def test_search_scorer_gives_the_three_scores_at_once(fitted):
             "recall": recall_scorer(index, X_test, y_test),
             "pruning_at_recall": make_pruning_scorer(0.9)(index, X_test, y_test),
         }
+        for name, value in scores.items():  # one factory: each score alone is the dict's entry
+            assert make_search_scorer(0.9, score=name)(index, X_test, y_test) == value
     assert "min_recall=0.8" in repr(make_search_scorer(0.8))
     with pytest.raises(ValueError, match="min_recall"):
         make_search_scorer(-0.1)
+    with pytest.raises(ValueError, match="score"):
+        make_search_scorer(score="precision")

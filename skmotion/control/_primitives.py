@@ -10,7 +10,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
 from skmotion.control._simulate import ArmSimulation, simulate_arm
-from skmotion.utils._clips import check_clips
+from skmotion.utils._clips import check_clips, split_frames
 from skmotion.utils._sklearn_compat import Interval, _fit_context
 
 __all__ = ["KMeansPrimitiveController"]
@@ -174,8 +174,8 @@ class KMeansPrimitiveController(ClipFeatureMixin, BaseEstimator):
         return self
 
     def _per_clip(self, codes, values):
-        offsets = np.cumsum([0] + [len(c) for c in codes])
-        return [values[a:b] for a, b in zip(offsets[:-1], offsets[1:])]
+        """Per-segment ``values`` of all clips, stacked, split back into one array per clip."""
+        return split_frames(values, np.concatenate([[0], np.cumsum(codes.lengths)]))
 
     def _labels(self, codes):
         """The nearest centre of every segment of every clip, stacked."""

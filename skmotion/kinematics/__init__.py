@@ -1,5 +1,6 @@
 """Kinematics: the Skeleton, rotation conventions and batched forward kinematics."""
 
+from skmotion.kinematics._body_size import body_size
 from skmotion.kinematics._forward import FKResult, forward_kinematics
 from skmotion.kinematics._rotations import (
     check_rotation_order,
@@ -13,6 +14,7 @@ __all__ = [
     "CHANNEL_KINDS",
     "FKResult",
     "Skeleton",
+    "body_size",
     "check_rotation_order",
     "euler_to_matrix",
     "forward_kinematics",

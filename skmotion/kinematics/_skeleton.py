@@ -286,7 +286,8 @@ class Skeleton:
         j = self.joint_index(joint)
         if channel not in self.channels[j]:
             raise KeyError(
-                f"Joint {self.joints[j]!r} has no channel {channel!r}; it has {list(self.channels[j])}."
+                f"Joint {self.joints[j]!r} has no channel {channel!r}; "
+                f"it has {list(self.channels[j])}."
             )
         start = sum(len(c) for c in self.channels[:j])
         return start + self.channels[j].index(channel)

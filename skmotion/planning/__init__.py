@@ -1,5 +1,9 @@
-"""Motion planning on a motion database's transition graph, root motion recovery and IK (paper 000, V-C)."""
+"""Motion planning on a motion database's transition graph, root motion recovery and IK.
 
+Yamane, Yamaguchi and Nakamura, section V-C.
+"""
+
+from skmotion.planning._database import plan_from_database
 from skmotion.planning._ik import damped_ik, facing_pose, marker_jacobian, plan_axes
 from skmotion.planning._plan import MotionPlan, SkeletonModel, node_root_velocity, plan_motion
 from skmotion.planning._root_motion import planar_step, rigid_root_velocity, skeleton_root_velocity
@@ -16,6 +20,7 @@ __all__ = [
     "marker_jacobian",
     "node_root_velocity",
     "plan_axes",
+    "plan_from_database",
     "plan_motion",
     "planar_step",
     "rigid_root_velocity",

@@ -16,7 +16,9 @@ __all__ = ["damped_ik", "facing_pose", "marker_jacobian", "plan_axes"]
 
 
 def plan_axes(up_axis):
-    """The matrix ``T`` with ``plan = world @ T``: world axes to the planner's (x forward, y left, z up).
+    """The matrix ``T`` with ``plan = world @ T``: world axes to the planner's.
+
+    The planner's axes are x forward, y left, z up.
 
     The planner's frame is right-handed with ``z`` up. Its ``x`` and ``y``
     are the world axes following the up axis cyclically, so a Y-up skeleton
@@ -34,7 +36,8 @@ def plan_axes(up_axis):
     Examples
     --------
     >>> from skmotion.planning import plan_axes
-    >>> plan_axes("y").astype(int).tolist()   # world z -> plan x, world x -> plan y, world y -> plan z
+    >>> # world z -> plan x, world x -> plan y, world y -> plan z
+    >>> plan_axes("y").astype(int).tolist()
     [[0, 1, 0], [0, 0, 1], [1, 0, 0]]
     """
     u = "xyz".index(up_axis.lower())
@@ -132,7 +135,8 @@ def damped_ik(skeleton, markers, targets, initial, *, damping=1e-2, n_iter=30, t
     ...                [["Zrotation"], ["Zrotation"], []])
     >>> tip = MarkerSet([("tip", "c", (0, 0, 0))])
     >>> q, rms = damped_ik(arm, tip, np.array([[[1.0, 1.0, 0.0]]]), np.array([[1.2, -1.2]]))
-    >>> np.degrees(np.angle(np.exp(1j * q))).round(3) + 0.0, float(rms[0]) < 1e-6   # up 90, then back 90
+    >>> # up 90, then back 90
+    >>> np.degrees(np.angle(np.exp(1j * q))).round(3) + 0.0, float(rms[0]) < 1e-6
     (array([[ 90., -90.]]), True)
     """
     q = np.array(initial, dtype=float)
@@ -152,7 +156,7 @@ def damped_ik(skeleton, markers, targets, initial, *, damping=1e-2, n_iter=30, t
 
 
 def facing_pose(skeleton, markers, targets, *, root, left, right):
-    """Starting channels for IK: the rest pose turned to the targets' facing, its root marker on theirs.
+    """Starting channels for IK: the rest pose turned to the targets' facing, root marker on theirs.
 
     Parameters
     ----------
@@ -188,7 +192,8 @@ def facing_pose(skeleton, markers, targets, *, root, left, right):
     positions = [c for c in ("Xposition", "Yposition", "Zposition") if c in root_channels]
     if len(positions) != 3:
         raise ValueError(
-            f"IK needs a root joint with three position channels; {skeleton.joints[0]!r} has {root_channels}."
+            f"IK needs a root joint with three position channels; {skeleton.joints[0]!r} has "
+            f"{root_channels}."
         )
     rest = markers.positions(skeleton, q[:1])[0]
 

@@ -1,8 +1,8 @@
 """Planning on a motion database: root motion per node, the search, and the planned motion.
 
-Knows nothing of sklearn: :meth:`MotionTreeHMM.plan` validates its input and
-calls :func:`plan_motion` with the node means and transition counts of one
-layer.
+Knows nothing of sklearn: :func:`plan_from_database` (behind
+:meth:`MotionTreeHMM.plan`) validates its input and calls :func:`plan_motion`
+with the node means and transition counts of one layer.
 """
 
 import math
@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from skmotion.io import Motion
+from skmotion.kinematics import body_size as chain_size
 from skmotion.kinematics import euler_to_matrix, matrix_to_euler, yaw_matrix
 from skmotion.planning._ik import damped_ik, facing_pose, plan_axes
 from skmotion.planning._root_motion import planar_step, rigid_root_velocity, skeleton_root_velocity
 from skmotion.planning._search import astar_search
-from skmotion.preprocessing._body_frame import body_size as chain_size
 
 __all__ = ["MotionPlan", "SkeletonModel", "default_body_size", "node_root_velocity", "plan_motion"]
 
@@ -62,7 +62,10 @@ class SkeletonModel:
         return cls(skeleton, markers, root, left, right, size)
 
     def solve(self, body_positions):
-        """Channels whose markers fit body-frame positions ``(n, n_markers, 3)``, and the RMS error (data units)."""
+        """Channels whose markers fit body-frame positions ``(n, n_markers, 3)``; the RMS error.
+
+        The error is in data units.
+        """
         targets = body_positions * self.units_per_size @ plan_axes(self.skeleton.up_axis).T
         q0 = facing_pose(
             self.skeleton, self.markers, targets, root=self.root, left=self.left, right=self.right
@@ -163,7 +166,10 @@ class MotionPlan:
         return float(np.hypot(*(self.root[-1, :2] - self.goal)))
 
     def marker_positions(self):
-        """World marker positions of the frames on the planning floor, ``(n_frames, n_markers, 3)`` metres."""
+        """World marker positions of the frames on the planning floor, metres.
+
+        Shape ``(n_frames, n_markers, 3)``.
+        """
         local = self.frames.reshape(self.n_frames, -1, 6)[..., :3] * self.body_size
         turn = yaw_matrix(self.root[:, 2], "z")
         out = np.einsum("fij,fmj->fmi", turn, local)
@@ -215,16 +221,11 @@ def plan_motion(
     *,
     frame_rate,
     body_size,
-    max_frames,
-    tolerance,
     start_node=None,
     model=None,
-    heuristic_weight=8.0,
-    cell=0.05,
-    heading_bins=36,
-    max_expansions=500_000,
     damping=1e-3,
     layer=-1,
+    **search,
 ):
     """Plan a motion on one layer of a motion database; see :meth:`MotionTreeHMM.plan`.
 
@@ -239,11 +240,17 @@ def plan_motion(
         Frames per node (the start prior).
     start : tuple of (float, float, float)
     goal : tuple of (float, float)
-    frame_rate, body_size, max_frames, tolerance : float, float, int, float
+    frame_rate, body_size : float
     start_node : int, default=None
     model : SkeletonModel, default=None
-    heuristic_weight, cell, heading_bins, max_expansions, damping, layer
-        See :func:`astar_search` and :func:`node_root_velocity`.
+    damping : float, default=1e-3
+        See :func:`node_root_velocity`.
+    layer : int, default=-1
+        Recorded in the plan.
+    **search
+        The keywords of :func:`astar_search`: ``tolerance`` and ``max_frames``
+        (required), ``heuristic_weight``, ``cell``, ``heading_bins``,
+        ``max_expansions``, ``dwell_span``.
 
     Returns
     -------
@@ -266,21 +273,7 @@ def plan_motion(
         start_costs = np.full(len(means), np.inf)
         start_costs[start_node] = 0.0
     began = time.perf_counter()
-    result = astar_search(
-        indptr,
-        indices,
-        costs,
-        steps,
-        start_costs,
-        start,
-        goal,
-        tolerance=tolerance,
-        max_frames=max_frames,
-        heuristic_weight=heuristic_weight,
-        cell=cell,
-        heading_bins=heading_bins,
-        max_expansions=max_expansions,
-    )
+    result = astar_search(indptr, indices, costs, steps, start_costs, start, goal, **search)
     search_seconds = time.perf_counter() - began
     nodes = result.nodes
     path_counts = np.asarray(counts[nodes[:-1], nodes[1:]]).ravel()

@@ -148,7 +148,8 @@ def planar_step(velocity, dt):
     --------
     >>> import numpy as np
     >>> from skmotion.planning import planar_step
-    >>> planar_step(np.array([[1.0, 0.0, np.pi / 2]]), 1.0).round(6)   # a quarter circle of radius 2/pi
+    >>> # a quarter circle of radius 2/pi
+    >>> planar_step(np.array([[1.0, 0.0, np.pi / 2]]), 1.0).round(6)
     array([[0.63662 , 0.63662 , 1.570796]])
     """
     ux, uy, w = velocity[:, 0], velocity[:, 1], velocity[:, 2]

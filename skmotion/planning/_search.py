@@ -18,9 +18,11 @@ Poses are merged into cells (``cell`` metres, ``heading_bins`` headings) per
 node, the first (cheapest) arrival keeping its exact pose, as in hybrid A*.
 """
 
+import functools
 import heapq
 import math
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -65,8 +67,8 @@ class SearchResult:
 def _graph_lists(indptr, indices, costs, steps, max_dwell, dwell_span):
     """Per node: its self-loop cost (or None), its other successors, and its dwell displacements.
 
-    ``dwell[m][k - 1]`` is the body-frame displacement after ``k`` frames in
-    node ``m`` (a constant twist, composed exactly), for ``k`` from 1 to
+    ``dwell[m][k]`` is the body-frame displacement after ``k`` frames in node
+    ``m`` (a constant twist, composed exactly), for ``k`` from 0 (none) to
     ``dwell_span`` times the node's mean dwell ``1 / (1 - p(m -> m))``: a
     longer stay has probability below ``exp(-dwell_span)``.
     """
@@ -83,9 +85,8 @@ def _graph_lists(indptr, indices, costs, steps, max_dwell, dwell_span):
             longest = (
                 max_dwell if leave <= 0 else int(min(max_dwell, math.ceil(dwell_span / leave)))
             )
-        k = np.arange(1, longest + 1)
         dx, dy, dh = steps[m]
-        dwell.append(_compose(dx, dy, dh, k))
+        dwell.append(np.vstack([np.zeros((1, 3)), _compose(dx, dy, dh, np.arange(1, longest + 1))]))
     return loops, moves, dwell
 
 
@@ -100,6 +101,236 @@ def _compose(dx, dy, dh, k):
     return np.column_stack(
         [cx - (np.cos(a) * cx - np.sin(a) * cy), cy - (np.sin(a) * cx + np.cos(a) * cy), a]
     )
+
+
+def _advance(pose, displacements):
+    """World poses ``(x, y, heading)`` after body-frame displacements ``(k, 3)`` from ``pose``."""
+    x, y, h = pose
+    c, s = math.cos(h), math.sin(h)
+    dx, dy, dh = displacements.T
+    return x + c * dx - s * dy, y + s * dx + c * dy, h + dh
+
+
+@dataclass(frozen=True)
+class _LowerBound:
+    """The admissible lower bound of the cost still to go, and the frames a distance needs.
+
+    No frame moves the root farther than ``s_max`` and none costs less than
+    ``c_min``, and no transition costs less than ``r`` per metre moved; the
+    bound is weighted by ``w`` (see the module notes).
+    """
+
+    tol: float
+    s_max: float
+    c_min: float
+    r: float
+    w: float
+
+    @classmethod
+    def of_graph(cls, indptr, costs, steps, tolerance, heuristic_weight):
+        lengths = np.hypot(steps[:, 0], steps[:, 1])
+        costs = np.asarray(costs, dtype=float)
+        src = np.repeat(np.arange(len(indptr) - 1), np.diff(indptr))
+        moving = lengths[src] > 0
+        return cls(
+            tol=float(tolerance),
+            s_max=float(lengths.max()) if len(lengths) else 0.0,
+            c_min=float(costs.min()) if len(costs) else math.inf,
+            r=float((costs[moving] / lengths[src][moving]).min()) if moving.any() else 0.0,
+            w=float(heuristic_weight),
+        )
+
+    def frames(self, d):
+        """The fewest frames that take the root from distance ``d`` to within ``tol``."""
+        if self.s_max == 0:
+            return np.where(d <= self.tol, 0, np.inf)
+        return np.where(d <= self.tol, 0, np.ceil((d - self.tol) / self.s_max - 1e-12))
+
+    def cost(self, d, frames):
+        """The weighted lower bound at distance ``d``, which needs ``frames`` more frames.
+
+        Called where some transition is seen (``c_min`` finite) or ``d > tol``.
+        """
+        bound = self.w * np.maximum(self.c_min * frames, self.r * (d - self.tol))
+        return np.where(d <= self.tol, 0.0, bound)
+
+
+class _Entry(NamedTuple):
+    """A search entry: the path enters graph ``node`` at ``frame``, pose ``(x, y, h)``, ``cost``.
+
+    Entries order as tuples: by ``priority`` (the cost plus the lower bound
+    still to go), ties to the lower ``index`` (the order they were made in).
+    ``node`` -1 is a path that ends at the goal inside its parent's dwell;
+    ``dwell`` is how many frames the parent stayed in its node before this entry.
+    """
+
+    priority: float
+    index: int
+    node: int
+    x: float
+    y: float
+    h: float
+    parent: int
+    frame: int
+    cost: float
+    dwell: int
+
+    @property
+    def pose(self):
+        return self.x, self.y, self.h
+
+
+# An entry kept as a plain tuple, handed out as an _Entry (C-level, unlike _Entry's own __new__).
+_as_entry = functools.partial(tuple.__new__, _Entry)
+
+
+class _OpenSet:
+    """Every entry made (by index), and a heap of the open ones, the least first.
+
+    Entries are stored as plain tuples in :class:`_Entry`'s field order and
+    handed out as :class:`_Entry`: the garbage collector stops tracking a plain
+    tuple of numbers (never a tuple subclass), which keeps its passes short
+    however many entries a search makes.
+    """
+
+    def __init__(self):
+        self._entries = []
+        self._heap = []
+
+    def __bool__(self):
+        return bool(self._heap)
+
+    def push(self, priority, node, pose, parent, frame, cost, dwell):
+        """Make an entry and open it; returns its index."""
+        entry = (priority, len(self._entries), node, *pose, parent, frame, cost, dwell)
+        self._entries.append(entry)
+        heapq.heappush(self._heap, entry)
+        return entry[1]
+
+    def pop(self):
+        """The open entry of the least priority, closed."""
+        return _as_entry(heapq.heappop(self._heap))
+
+    def entry(self, i):
+        return _as_entry(self._entries[i])
+
+    def chain(self, i):
+        """The entries from a start to entry ``i``."""
+        out = []
+        while i >= 0:
+            out.append(self.entry(i))
+            i = out[-1].parent
+        return out[::-1]
+
+
+class _Search:
+    """Weighted A* over (node, pose) with poses merged into cells; see :func:`astar_search`."""
+
+    def __init__(self, graph, bound, goal, *, max_frames, cell, heading_bins, closest):
+        self.loops, self.moves, self.dwell = graph
+        self.bound, self.goal, self.max_frames = bound, goal, max_frames
+        self.cell, self.heading_bins = cell, heading_bins
+        self.open, self.best = _OpenSet(), {}
+        self.expansions, self.fallback, self.closest = 0, -1, closest
+
+    def key(self, node, x, y, h):
+        """The cell of a pose in a node."""
+        turn = (h % (2.0 * math.pi)) / (2.0 * math.pi)
+        return (
+            node,
+            int(np.rint(x / self.cell)),
+            int(np.rint(y / self.cell)),
+            int(turn * self.heading_bins),
+        )
+
+    def keys(self, x, y, h):
+        """The cells of arrays of poses, as int arrays ``(ix, iy, ih)``."""
+        turn = (h % (2.0 * math.pi)) / (2.0 * math.pi)
+        ix, iy = (np.rint(v / self.cell).astype(np.int64) for v in (x, y))
+        return ix, iy, (turn * self.heading_bins).astype(np.int64)
+
+    def run(self, max_expansions):
+        """The index of the entry that ends the path found, or -1."""
+        pop, best, cell_of = self.open.pop, self.best, self.key  # local names: the hot loop
+        while self.open:
+            entry = pop()
+            _, i, node, x, y, h, _, _, cost, _ = entry
+            if node < 0:
+                return i
+            key = cell_of(node, x, y, h)
+            if best.get(key, math.inf) < cost:
+                continue
+            best[key] = cost
+            self.expansions += 1
+            if self.expansions > max_expansions:
+                # Out of budget: the cheapest path found so far that ends at the goal, if any
+                # (it reaches the goal on seen transitions, but its cost is not proven minimal).
+                return self.fallback
+            self.expand(i, entry)
+        return -1
+
+    def expand(self, i, entry):
+        """Every dwell in the entry's node at once: an end at the goal, then the next nodes."""
+        n = entry.node
+        # poses at frames t .. t + k: k frames in n (k = 0 is the entry's own pose)
+        x, y, h = _advance(entry.pose, self.dwell[n][: self.max_frames - entry.frame + 1])
+        dist = np.hypot(self.goal[0] - x, self.goal[1] - y)
+        self.closest = min(self.closest, float(dist.min()))
+        # A node without a self-loop is left after one frame: j = 0 stays only.
+        loop = self.loops[n] if self.loops[n] is not None else 0.0
+        at_goal = np.flatnonzero(
+            dist[: len(dist) - 1 if self.loops[n] is not None else 1] <= self.bound.tol
+        )
+        if len(at_goal):
+            j = int(at_goal[0])  # end at frame t + j, after j self-loops
+            cost = entry.cost + j * loop
+            pose = (float(x[j]), float(y[j]), float(h[j]))
+            end = self.open.push(cost, -1, pose, i, entry.frame + j, cost, j + 1)
+            if self.fallback < 0 or cost < self.open.entry(self.fallback).cost:
+                self.fallback = end
+        self.push_moves(i, entry, loop, (x[1:], y[1:], h[1:]), dist[1:])
+
+    def push_moves(self, i, entry, loop, poses, dist):
+        """Leave the node after ``j + 1`` frames (pose ``poses[:, j]``) to each successor."""
+        need = self.bound.frames(dist)
+        ok = np.flatnonzero(entry.frame + np.arange(1, len(dist) + 1) + need < self.max_frames)
+        moves = self.moves[entry.node]
+        if not len(ok) or not moves:
+            return
+        lower = self.bound.cost(dist, need)
+        ix, iy, ih = self.keys(*poses)
+        # A longer dwell ending in the same cell as a shorter one costs more and would be
+        # merged into it: only the first dwell into each cell is worth a push.
+        fresh = np.ones(len(ix), dtype=bool)
+        fresh[1:] = (np.diff(ix) != 0) | (np.diff(iy) != 0) | (np.diff(ih) != 0)
+        ok = ok[fresh[ok]]
+        ix, iy, ih, lower = ix.tolist(), iy.tolist(), ih.tolist(), lower.tolist()
+        x, y, h = poses
+        best_get, push = self.best.get, self.open.push  # local names: the hot loop
+        for j in ok.tolist():
+            base, pose, frame = entry.cost + j * loop, None, entry.frame + j + 1
+            for m, cost in moves:
+                g = base + cost
+                if best_get((m, ix[j], iy[j], ih[j]), math.inf) <= g:
+                    continue
+                if pose is None:
+                    pose = (float(x[j]), float(y[j]), float(h[j]))
+                push(g + lower[j], m, pose, i, frame, g, j + 1)
+
+    def result(self, found):
+        """The path that ends at entry ``found``, frame by frame."""
+        chain = self.open.chain(found)
+        nodes, poses = [], []
+        for a, b in zip(chain[:-1], chain[1:]):
+            # entry a dwelt b.dwell frames in its node before b
+            nodes += [a.node] * b.dwell
+            poses.append(np.column_stack(_advance(a.pose, self.dwell[a.node][: b.dwell])))
+        return SearchResult(
+            nodes=np.array(nodes, dtype=np.intp),
+            poses=np.vstack(poses),
+            cost=chain[-1].cost,
+            expansions=self.expansions,
+        )
 
 
 def astar_search(
@@ -164,187 +395,44 @@ def astar_search(
     >>> indptr, indices = np.array([0, 2, 3]), np.array([0, 1, 1])
     >>> costs = -np.log([0.9, 0.1, 1.0])
     >>> steps = np.array([[0.1, 0.0, 0.0], [0.0, 0.1, 0.0]])
-    >>> r = astar_search(indptr, indices, costs, steps, np.array([0.0, np.inf]), (0, 0, 0), (0.5, 0.3),
-    ...                  tolerance=0.01, max_frames=20)
+    >>> r = astar_search(indptr, indices, costs, steps, np.array([0.0, np.inf]), (0, 0, 0),
+    ...                  (0.5, 0.3), tolerance=0.01, max_frames=20)
     >>> r.nodes.tolist(), r.poses[-1].round(6).tolist()
     ([0, 0, 0, 0, 0, 1, 1, 1, 1], [0.5, 0.3, 0.0])
     """
-    gx, gy = float(goal[0]), float(goal[1])
-    tol = float(tolerance)
-    lengths = np.hypot(steps[:, 0], steps[:, 1])
-    s_max = float(lengths.max()) if len(lengths) else 0.0
-    seen_costs = np.asarray(costs, dtype=float)
-    c_min = float(seen_costs.min()) if len(seen_costs) else math.inf
-    src = np.repeat(np.arange(len(indptr) - 1), np.diff(indptr))
-    moving = lengths[src] > 0
-    r = float((seen_costs[moving] / lengths[src][moving]).min()) if moving.any() else 0.0
-    w = float(heuristic_weight)
-    loops, moves, dwell = _graph_lists(indptr, indices, costs, steps, max_frames, dwell_span)
-
-    def frames_needed(d):
-        if d <= tol:
-            return 0
-        return math.inf if s_max == 0 else math.ceil((d - tol) / s_max - 1e-12)
-
-    def heuristic(d):
-        if d <= tol:
-            return 0.0
-        return w * max(c_min * frames_needed(d), r * (d - tol))
-
-    d0 = math.hypot(gx - start[0], gy - start[1])
-    if frames_needed(d0) >= max_frames:
+    bound = _LowerBound.of_graph(indptr, costs, steps, tolerance, heuristic_weight)
+    goal = (float(goal[0]), float(goal[1]))
+    d0 = math.hypot(goal[0] - start[0], goal[1] - start[1])
+    if bound.frames(d0) >= max_frames:
         raise UnreachableGoalError(
             f"the goal is {d0:.3f} m away, but the fastest motion of the database covers at most "
-            f"{s_max * (max_frames - 1):.3f} m in max_frames={max_frames} frames.",
+            f"{bound.s_max * (max_frames - 1):.3f} m in max_frames={max_frames} frames.",
             closest=d0,
         )
-    two_pi = 2.0 * math.pi
-
-    def key_of(n, x, y, h):
-        return (
-            n,
-            int(np.rint(x / cell)),
-            int(np.rint(y / cell)),
-            int((h % two_pi) / two_pi * heading_bins),
-        )
-
-    # A search node enters graph node n at frame t with pose (x, y, h) and cost g; expanding it
-    # chooses how many frames to dwell in n (self-loops) and the next node. A terminal entry
-    # (n = -1) is a path that ends inside its last dwell, at the goal.
-    nodes, poses, parents, frames, gs, dwells = [], [], [], [], [], []
-    heap, best = [], {}
-
-    def push(n, pose, parent, t, g, f, k=0):
-        nodes.append(n)
-        poses.append(pose)
-        parents.append(parent)
-        frames.append(t)
-        gs.append(g)
-        dwells.append(k)
-        heapq.heappush(heap, (f, len(nodes) - 1))
-
+    search = _Search(
+        _graph_lists(indptr, indices, costs, steps, max_frames, dwell_span),
+        bound,
+        goal,
+        max_frames=max_frames,
+        cell=cell,
+        heading_bins=heading_bins,
+        closest=d0,
+    )
+    start_bound = 0.0 if d0 <= bound.tol else float(bound.cost(d0, bound.frames(d0)))
     for n in np.flatnonzero(np.isfinite(start_costs)):
-        push(
-            int(n),
-            tuple(map(float, start)),
-            -1,
-            0,
-            float(start_costs[n]),
-            float(start_costs[n]) + heuristic(d0),
-        )
-    closest, expansions, found, fallback = d0, 0, -1, -1
-    while heap:
-        _, i = heapq.heappop(heap)
-        n, g, t = nodes[i], gs[i], frames[i]
-        if n < 0:
-            found = i
-            break
-        x, y, h = poses[i]
-        key = key_of(n, x, y, h)
-        if best.get(key, math.inf) < g:
-            continue
-        best[key] = g
-        expansions += 1
-        if expansions > max_expansions:
-            # Out of budget: the cheapest path found so far that ends at the goal, if any
-            # (it reaches the goal on seen transitions, but its cost is not proven minimal).
-            found = fallback
-            break
-        # Every dwell of k frames in n at once: poses of its frames t .. t + k - 1 and after it.
-        room = max_frames - t
-        table = dwell[n][:room]
-        c, s = math.cos(h), math.sin(h)
-        px = np.concatenate([[x], x + c * table[:, 0] - s * table[:, 1]])
-        py = np.concatenate([[y], y + s * table[:, 0] + c * table[:, 1]])
-        ph = np.concatenate([[h], h + table[:, 2]])
-        dist = np.hypot(gx - px, gy - py)
-        closest = min(closest, float(dist.min()))
-        loop = loops[n] if loops[n] is not None else math.inf
-        at_goal = (
-            np.flatnonzero(dist[: len(table)] <= tol)
-            if loops[n] is not None
-            else np.flatnonzero(dist[:1] <= tol)
-        )
-        if len(at_goal):
-            j = int(at_goal[0])  # end at frame t + j, after j self-loops
-            push(
-                -1,
-                (float(px[j]), float(py[j]), float(ph[j])),
-                i,
-                t + j,
-                g + j * loop,
-                g + j * loop,
-                j + 1,
-            )
-            if fallback < 0 or gs[-1] < gs[fallback]:
-                fallback = len(nodes) - 1
-        # All dwells at once: the frame after, the lower bound still to go, the cell keys.
-        ks = np.arange(1, len(table) + 1)
-        dk = dist[1:]
-        need = (
-            np.where(dk <= tol, 0, np.ceil((dk - tol) / s_max - 1e-12))
-            if s_max > 0
-            else np.where(dk <= tol, 0, np.inf)
-        )
-        ok = np.flatnonzero(t + ks + need < max_frames)
-        if not len(ok) or not moves[n]:
-            continue
-        hk = np.where(dk <= tol, 0.0, w * np.maximum(c_min * need, r * (dk - tol)))
-        ix = np.rint(px[1:] / cell).astype(np.int64)
-        iy = np.rint(py[1:] / cell).astype(np.int64)
-        ih = ((ph[1:] % two_pi) / two_pi * heading_bins).astype(np.int64)
-        # A longer dwell ending in the same cell as a shorter one costs more and would be
-        # merged into it: only the first dwell into each cell is worth a push.
-        fresh = np.ones(len(ix), dtype=bool)
-        fresh[1:] = (np.diff(ix) != 0) | (np.diff(iy) != 0) | (np.diff(ih) != 0)
-        ok = ok[fresh[ok]]
-        ix, iy, ih, hk = ix.tolist(), iy.tolist(), ih.tolist(), hk.tolist()
-        for j in ok.tolist():
-            base = g + j * loop
-            pose = None
-            for m, cost in moves[n]:
-                ng = base + cost
-                if best.get((m, ix[j], iy[j], ih[j]), math.inf) <= ng:
-                    continue
-                if pose is None:
-                    pose = (float(px[j + 1]), float(py[j + 1]), float(ph[j + 1]))
-                push(m, pose, i, t + j + 1, ng, ng + hk[j], j + 1)
+        cost = float(start_costs[n])
+        search.open.push(cost + start_bound, int(n), tuple(map(float, start)), -1, 0, cost, 0)
+    found = search.run(max_expansions)
     if found < 0:
         why = (
             f"gave up after max_expansions={max_expansions} expansions"
-            if heap
+            if search.open
             else "every path was explored"
         )
         raise UnreachableGoalError(
-            f"no path of the transition graph takes the root within {tol:g} m of the goal in max_frames={max_frames} "
-            f"frames ({why}); the closest approach was {closest:.3f} m.",
-            closest=closest,
+            f"no path of the transition graph takes the root within {bound.tol:g} m of the goal "
+            f"in max_frames={max_frames} frames ({why}); the closest approach was "
+            f"{search.closest:.3f} m.",
+            closest=search.closest,
         )
-    # Unroll: each entry dwelt dwells[child] frames in its node before the child's node.
-    chain = []
-    while found >= 0:
-        chain.append(found)
-        found = parents[found]
-    chain.reverse()
-    out_nodes, out_poses = [], []
-    for a, b in zip(chain[:-1], chain[1:]):
-        k = dwells[b]
-        x, y, h = poses[a]
-        table = np.vstack([[0.0, 0.0, 0.0], dwell[nodes[a]][: k - 1]])
-        c, s = math.cos(h), math.sin(h)
-        out_nodes += [nodes[a]] * k
-        out_poses.append(
-            np.column_stack(
-                [
-                    x + c * table[:, 0] - s * table[:, 1],
-                    y + s * table[:, 0] + c * table[:, 1],
-                    h + table[:, 2],
-                ]
-            )
-        )
-    return SearchResult(
-        nodes=np.array(out_nodes, dtype=np.intp),
-        poses=np.vstack(out_poses),
-        cost=gs[chain[-1]],
-        expansions=expansions,
-    )
+    return search.result(found)

@@ -54,15 +54,8 @@ def decode_clips(
     offsets,
     *,
     n_graphs,
-    layer,
-    n_paths,
-    node_prior,
-    score_layers=1,
-    guide=None,
-    normalise=True,
-    prune=False,
-    return_paths=True,
     n_jobs=None,
+    **options,
 ):
     """Beam-decode every clip under every graph (see :func:`beam_decode`).
 
@@ -75,10 +68,12 @@ def decode_clips(
     offsets : ndarray of shape (n_clips + 1,)
     n_graphs : int
         Decode each clip under graphs ``0 .. n_graphs - 1``.
-    layer, n_paths, node_prior, score_layers, guide, normalise, prune, return_paths
-        As for :func:`beam_decode`.
     n_jobs : int, default=None
         Jobs over the groups of clips (joblib's meaning); results do not depend on it.
+    **options
+        The keywords of :func:`beam_decode` (``layer`` is required): ``layer``,
+        ``n_paths``, ``score_layers``, ``node_prior``, ``guide``,
+        ``normalise``, ``prune``, ``return_paths``.
 
     Returns
     -------
@@ -88,26 +83,12 @@ def decode_clips(
         Their log scores at each scored layer.
     """
     lengths = np.diff(offsets)
+    return_paths = options.get("return_paths", True)
 
     def work(group):
-        clip_of_problem = np.repeat(group, n_graphs)
-        graph_of_problem = np.tile(np.arange(n_graphs), len(group))
-        paths, scores = beam_decode(
-            tree,
-            graphs,
-            frames,
-            offsets,
-            clip_of_problem,
-            graph_of_problem,
-            layer=layer,
-            n_paths=n_paths,
-            score_layers=score_layers,
-            node_prior=node_prior,
-            guide=guide,
-            normalise=normalise,
-            prune=prune,
-            return_paths=return_paths,
-        )
+        clips = np.repeat(group, n_graphs)
+        graph_ids = np.tile(np.arange(n_graphs), len(group))
+        paths, scores = beam_decode(tree, graphs, frames, offsets, clips, graph_ids, **options)
         if paths is not None:
             paths = paths.reshape(len(group), n_graphs, *paths.shape[1:])
         return paths, scores.reshape(len(group), n_graphs, *scores.shape[1:])

@@ -24,6 +24,12 @@ so far, and ties go to the lower candidate slot (or rank, then slot). Slot
 ``w``-th kept node; -1 is "no node". Emissions are ``log Po(x | k)``; the
 normaliser of ``Ps`` is the same for every candidate of a frame, so the caller
 subtracts its per-clip sum from the scores.
+
+:func:`decode_searches` allocates once (:func:`_allocate`, the longest search's
+scratch), then runs one search after another (:func:`_search`: steps 1, 2 and 4,
+with :func:`_score_layer` for step 3) and, for ``"prune"``, the lists of the
+problems still live (:func:`_prune`). The arrays it reads are laid out by
+:mod:`skmotion.tree._layout`.
 """
 
 import numpy as np
@@ -45,13 +51,12 @@ cdef extern from "_emission.h" nogil:
                       double* cur)
 
 #: What a call computes per problem; see :func:`decode_searches`.
-MODES = ("beam", "best", "kbest", "prune")
+MODES = ("best", "kbest", "prune")
 
 cdef enum:
-    BEAM = 0
-    BEST = 1
-    KBEST = 2
-    PRUNE = 3
+    BEST = 0
+    KBEST = 1
+    PRUNE = 2
 
 
 cdef struct Gaussians:
@@ -571,6 +576,159 @@ cdef void _score(intp mode, intp n_steps, intp n_cand, intp n_paths, const Layer
                path_stride, scores)
 
 
+cdef struct Decode:
+    # What one call decodes: the searches' inputs, the layers, the outputs and the scratch.
+    const double* frames        # (n_frames, d)
+    const intp* frame_start     # (n_searches,)
+    const intp* n_steps         # (n_searches,)
+    const intp* search_graph    # (n_searches,)
+    const intp* problem_start   # (n_searches + 1,)
+    const intp* score_graph     # (n_problems,)
+    Layer* lays                 # entries 1 .. n_layers
+    Gaussians g
+    intp n_layers
+    intp first_scored
+    intp n_scored
+    intp n_paths
+    intp max_steps
+    intp mode
+    double* scores              # (n_problems, n_scored, n_paths)
+    intp* paths                 # (n_problems, n_paths, max_steps), or NULL when no paths are wanted
+    Work w
+    intp* best_widths           # (n_scored,) candidates per frame at each scored layer ("prune")
+    double* best_sum            # (n_problems,) summed best scores ("prune")
+    bint* live                  # (n_problems,) problems that may still win their search ("prune")
+
+
+cdef void _release(Decode* dec) noexcept:
+    _free_work(&dec.w)
+    free(dec.lays)
+    free(dec.best_widths)
+    free(dec.best_sum)
+    free(dec.live)
+
+
+cdef int _allocate(Decode* dec, list layers, intp n_searches, intp n_problems) except -1:
+    """The layers' views and the scratch of the longest search; a MemoryError when they do not fit.
+
+    Everything is allocated before anything may raise, so :func:`_release` always applies.
+    """
+    cdef intp s, l, max_graphs = 0
+    cdef intp slots = 1 + (dec.n_scored if dec.mode == PRUNE else 0)
+    for s in range(n_searches):
+        max_graphs = max(max_graphs, dec.problem_start[s + 1] - dec.problem_start[s])
+    dec.lays = <Layer*> malloc((dec.n_layers + 1) * sizeof(Layer))
+    dec.best_widths = <intp*> malloc((dec.n_scored + 1) * sizeof(intp))
+    dec.best_sum = <double*> malloc(max(n_problems, 1) * sizeof(double))
+    dec.live = <bint*> malloc(max(n_problems, 1) * sizeof(bint))
+    cdef bint ok = _alloc_work(&dec.w, dec.max_steps, dec.n_paths, slots, dec.g.d, dec.paths != NULL,
+                               max_graphs)
+    if not ok or dec.lays == NULL or dec.best_widths == NULL or dec.best_sum == NULL or dec.live == NULL:
+        raise MemoryError(f"decoding {dec.max_steps} frames with {2 * dec.n_paths} candidates each")
+    for l in range(1, dec.n_layers + 1):
+        dec.lays[l] = _layer(layers[l])
+    return 0
+
+
+cdef void _score_layer(Decode* dec, intp s, intp l, intp n_cand, const intp* cand, const double* emit) noexcept nogil:
+    """Every problem of search ``s`` at scored layer ``l``: the best score, or the ``n_paths`` best sequences.
+
+    With ``"prune"`` the best scores alone (summed per problem into ``best_sum``);
+    the lists come after the last layer, for the problems still live.
+    """
+    cdef intp p, li = l - dec.first_scored, p0 = dec.problem_start[s], p1 = dec.problem_start[s + 1]
+    cdef intp row = dec.n_scored * dec.n_paths
+    cdef const Layer* lay = &dec.lays[l]
+    cdef bint paths_now = dec.paths != NULL and l == dec.n_layers and dec.mode == KBEST
+    dec.best_widths[li] = n_cand
+    if dec.mode != KBEST and lay.score_allowed == NULL and p1 > p0:
+        _best_all(dec.n_steps[s], n_cand, &lay.score, dec.score_graph + p0, p1 - p0, cand, emit, &dec.w,
+                  dec.scores + p0 * row + li * dec.n_paths, row)
+    else:
+        for p in range(p0, p1):
+            _score(BEST if dec.mode == PRUNE else dec.mode, dec.n_steps[s], n_cand, dec.n_paths, lay,
+                   dec.score_graph[p], cand, emit, &dec.w, dec.scores + p * row + li * dec.n_paths,
+                   dec.paths + p * dec.n_paths * dec.max_steps if paths_now else NULL, dec.max_steps)
+    if dec.mode == PRUNE:
+        for p in range(p0, p1):
+            dec.best_sum[p] += dec.scores[p * row + li * dec.n_paths]
+
+
+cdef void _search(Decode* dec, intp s) noexcept nogil:
+    """Search ``s`` top-down: each layer's candidates and emissions, its scores if scored, the next beam.
+
+    With ``"prune"`` each scored layer keeps its candidates and emissions in its
+    own slot of the scratch, for the lists :func:`_prune` may run afterwards.
+    """
+    cdef intp t, p, l, slot, n_cand, width = 1, n = dec.n_steps[s], n_paths = dec.n_paths
+    cdef intp slot_size = dec.max_steps * 2 * n_paths
+    cdef bint carry = False, scored, need
+    cdef Work* w = &dec.w
+    cdef intp* cand
+    cdef double* emit
+    cdef intp* tmp_i
+    cdef double* tmp_d
+    for t in range(n):
+        w.beam[t] = 0  # layer 0: the root
+    for p in range(dec.problem_start[s], dec.problem_start[s + 1]):
+        dec.best_sum[p] = 0.0
+    for l in range(1, dec.n_layers + 1):
+        scored = l >= dec.first_scored
+        slot = 1 + l - dec.first_scored if (scored and dec.mode == PRUNE) else 0
+        cand = w.cand + slot * slot_size
+        emit = w.emit + slot * slot_size
+        # emissions are needed to score this layer or to choose among its candidates
+        need = scored or (2 * width > n_paths and l < dec.n_layers)
+        n_cand = _candidates(&dec.lays[l], n, width, dec.search_graph[s], carry, &dec.g,
+                             dec.frames + dec.frame_start[s] * dec.g.d, w, cand, emit, need)
+        if scored:
+            _score_layer(dec, s, l, n_cand, cand, emit)
+        if l < dec.n_layers:
+            width = _keep(n, n_cand, n_paths, cand, emit, need, &dec.lays[l].search, dec.search_graph[s], w)
+            carry = need
+            tmp_i = w.beam
+            w.beam = w.next_beam
+            w.next_beam = tmp_i
+            tmp_d = w.beam_emit
+            w.beam_emit = w.next_emit
+            w.next_emit = tmp_d
+
+
+cdef void _prune(Decode* dec, intp s) noexcept nogil:
+    """``"prune"``: the lists of the problems of search ``s`` that may still hold its highest summed score.
+
+    The sum of ``n_paths`` sequences lies between the best one and ``n_paths``
+    times it, at each layer: a problem whose summed best scores plus
+    ``n_scored log(n_paths)`` stay below the best sum cannot win, and gets
+    ``-inf``. A search left with one live problem has its winner, which keeps
+    its best scores alone.
+    """
+    cdef intp p, li, l, n_live = 0, row = dec.n_scored * dec.n_paths
+    cdef intp slot_size = dec.max_steps * 2 * dec.n_paths
+    cdef double top = -INFINITY, margin = dec.n_scored * log(<double> dec.n_paths)
+    for p in range(dec.problem_start[s], dec.problem_start[s + 1]):
+        top = max(top, dec.best_sum[p])
+    for p in range(dec.problem_start[s], dec.problem_start[s + 1]):
+        # kept with a margin for rounding in the sums of n_paths terms
+        dec.live[p] = dec.best_sum[p] + margin >= top - 1e-9 * abs(top)
+        n_live += dec.live[p]
+        if not dec.live[p]:
+            for li in range(dec.n_scored):
+                dec.scores[p * row + li * dec.n_paths] = -INFINITY
+    if n_live == 1:
+        return
+    for p in range(dec.problem_start[s], dec.problem_start[s + 1]):
+        if not dec.live[p]:
+            continue
+        for li in range(dec.n_scored):
+            l = dec.first_scored + li
+            _score(KBEST, dec.n_steps[s], dec.best_widths[li], dec.n_paths, &dec.lays[l], dec.score_graph[p],
+                   dec.w.cand + (1 + li) * slot_size, dec.w.emit + (1 + li) * slot_size, &dec.w,
+                   dec.scores + p * row + li * dec.n_paths,
+                   dec.paths + p * dec.n_paths * dec.max_steps if dec.paths != NULL and l == dec.n_layers
+                   else NULL, dec.max_steps)
+
+
 def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, const intp[::1] n_steps,
                     const intp[::1] search_graph, const intp[::1] problem_start, const intp[::1] score_graph,
                     object gauss, list layers, intp first_scored, intp n_paths, str mode, bint want_paths):
@@ -588,19 +746,19 @@ def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, co
     problem_start : ndarray of shape (n_searches + 1,)
     score_graph : ndarray of shape (n_problems,)
     gauss : dict
-        :meth:`MotionTree.kernel_gaussians`.
+        The nodes' Gaussians as :func:`skmotion.tree._layout.gaussian_arrays` lays them out.
     layers : list
         Entry ``l`` (1 to ``L``; entry 0 is unused) is ``(children, ids,
-        search_table, score_table, search_allowed, score_allowed)``: the
-        children in layer ``l`` of the nodes of ``l - 1`` (``MotionTree.children``),
-        the layer's tree node ids, two :meth:`TransitionGraphs.kernel_table`, and
-        the allowed-node masks ``(n_graphs, K_l)`` of uint8, or ``(0, 0)`` for all nodes.
+        search_table, score_table, search_allowed, score_allowed)``, as
+        ``skmotion.tree._decode._layer_specs`` makes it: the children in
+        layer ``l`` of the nodes of ``l - 1``, the layer's tree node ids, the
+        two graphs' transition tables, and the allowed-node masks
+        ``(n_graphs, K_l)`` of uint8, or ``(0, 0)`` for all nodes.
     first_scored : int
         Layers ``first_scored .. L`` are scored (``1 <= first_scored <= L``).
     n_paths : int
         Nodes kept per frame, and sequences per problem.
-    mode : {"beam", "best", "kbest", "prune"}
-        ``"beam"``: no scoring; return each frame's kept nodes at layer ``L``.
+    mode : {"best", "kbest", "prune"}
         ``"best"``: the best sequence's score at each scored layer. ``"kbest"``:
         the ``n_paths`` best sequences. ``"prune"``: the best first; then the
         list only for the problems whose summed best scores plus
@@ -614,147 +772,49 @@ def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, co
     -------
     scores : ndarray of shape (n_problems, n_scored, n_paths)
         Log scores (``log Po`` emissions, no normaliser), best first; ``-inf``
-        for missing sequences. Empty for ``"beam"``.
+        for missing sequences.
     paths : ndarray of shape (n_problems, n_paths, max(n_steps)) or None
         Node sequences at layer ``L``; -1 past a clip's length and for missing ones.
-    beam : ndarray of shape (sum(n_steps), width) or None
-        ``"beam"`` only: each frame's kept nodes at layer ``L`` (search after
-        search), -1 for none.
     """
     if mode not in MODES:
         raise ValueError(f"mode must be one of {MODES}; got {mode!r}.")
-    cdef intp imode = MODES.index(mode)
-    cdef intp n_layers = len(layers) - 1, n_searches = frame_start.shape[0]
-    cdef intp n_problems = score_graph.shape[0]
-    cdef intp n_scored = 0 if imode == BEAM else n_layers - first_scored + 1
-    cdef intp max_steps = 0, total_steps = 0, max_graphs = 0, s, p, l, t, r, li, width, n_cand, slot, n_live
-    cdef intp slots = 1 + (n_scored if imode == PRUNE else 0)
-    cdef double top, margin
-    cdef bint carry, scored, need, paths_now
-    if n_layers < 1 or (imode != BEAM and not 1 <= first_scored <= n_layers):
-        raise ValueError(f"need 1 <= first_scored <= {n_layers} layers; got {first_scored}.")
+    cdef Decode dec
+    cdef intp s, n_searches = frame_start.shape[0], n_problems = score_graph.shape[0]
+    dec.n_layers = len(layers) - 1
+    if dec.n_layers < 1 or not 1 <= first_scored <= dec.n_layers:
+        raise ValueError(f"need 1 <= first_scored <= {dec.n_layers} layers; got {first_scored}.")
+    dec.mode = MODES.index(mode)
+    dec.first_scored = first_scored
+    dec.n_scored = dec.n_layers - first_scored + 1
+    dec.n_paths = n_paths
+    dec.max_steps = 0
     for s in range(n_searches):
-        max_steps = max(max_steps, n_steps[s])
-        total_steps += n_steps[s]
-        max_graphs = max(max_graphs, problem_start[s + 1] - problem_start[s])
-    cdef Gaussians g = _gaussians(gauss)
-    cdef Layer* lays = <Layer*> malloc((n_layers + 1) * sizeof(Layer))
-    if lays == NULL:
-        raise MemoryError("decoding layers")
-    for l in range(1, n_layers + 1):
-        lays[l] = _layer(layers[l])
-    scores_array = np.full((n_problems, n_scored, n_paths), -np.inf)
+        dec.max_steps = max(dec.max_steps, n_steps[s])
+    dec.frames = &frames[0, 0]
+    dec.frame_start = &frame_start[0]
+    dec.n_steps = &n_steps[0]
+    dec.search_graph = &search_graph[0]
+    dec.problem_start = &problem_start[0]
+    dec.score_graph = &score_graph[0]
+    dec.g = _gaussians(gauss)
+    scores_array = np.full((n_problems, dec.n_scored, n_paths), -np.inf)
     cdef double[:, :, ::1] scores = scores_array
+    dec.scores = &scores[0, 0, 0]
     paths_array = None
     cdef intp[:, :, ::1] paths
-    want_paths = want_paths and imode in (KBEST, PRUNE)
-    if want_paths:
-        paths_array = np.full((n_problems, n_paths, max_steps), -1, dtype=np.intp)
+    dec.paths = NULL
+    if want_paths and dec.mode != BEST:
+        paths_array = np.full((n_problems, n_paths, dec.max_steps), -1, dtype=np.intp)
         paths = paths_array
-    beam_array = None
-    cdef intp[:, ::1] beam_out
-    cdef intp* best_widths = <intp*> malloc((n_scored + 1) * sizeof(intp))
-    cdef double* best_sum = <double*> malloc(max(n_problems, 1) * sizeof(double))
-    cdef bint* live = <bint*> malloc(max(n_problems, 1) * sizeof(bint))
-    cdef Work w
-    cdef bint ok = _alloc_work(&w, max_steps, n_paths, slots, g.d, want_paths, max_graphs)
-    if not ok or best_widths == NULL or best_sum == NULL or live == NULL:
-        _free_work(&w); free(lays); free(best_widths); free(best_sum); free(live)
-        raise MemoryError(f"decoding {max_steps} frames with {2 * n_paths} candidates each")
-    cdef intp* cand
-    cdef double* emit
-    cdef intp* tmp_i
-    cdef double* tmp_d
-    cdef intp out_row = 0
+        dec.paths = &paths[0, 0, 0]
     try:
+        _allocate(&dec, layers, n_searches, n_problems)
         with nogil:
             for s in range(n_searches):
-                if n_steps[s] == 0:
-                    continue
-                for t in range(n_steps[s]):
-                    w.beam[t] = 0  # layer 0: the root
-                width = 1
-                carry = False
-                for p in range(problem_start[s], problem_start[s + 1]):
-                    best_sum[p] = 0.0
-                for l in range(1, n_layers + 1):
-                    scored = imode != BEAM and l >= first_scored
-                    li = l - first_scored
-                    slot = 1 + li if (scored and imode == PRUNE) else 0
-                    cand = w.cand + slot * max_steps * 2 * n_paths
-                    emit = w.emit + slot * max_steps * 2 * n_paths
-                    # emissions are needed to score this layer or to choose among its candidates
-                    need = scored or (2 * width > n_paths and (l < n_layers or imode == BEAM))
-                    n_cand = _candidates(&lays[l], n_steps[s], width, search_graph[s], carry, &g,
-                                         &frames[frame_start[s], 0], &w, cand, emit, need)
-                    if scored:
-                        best_widths[li] = n_cand
-                        paths_now = want_paths and l == n_layers and imode == KBEST
-                        p = problem_start[s]
-                        if imode != KBEST and lays[l].score_allowed == NULL and problem_start[s + 1] > p:
-                            _best_all(n_steps[s], n_cand, &lays[l].score, &score_graph[p], problem_start[s + 1] - p,
-                                      cand, emit, &w, &scores[p, li, 0], n_scored * n_paths)
-                        else:
-                            for p in range(problem_start[s], problem_start[s + 1]):
-                                _score(BEST if imode == PRUNE else imode, n_steps[s], n_cand, n_paths, &lays[l],
-                                       score_graph[p], cand, emit, &w, &scores[p, li, 0],
-                                       &paths[p, 0, 0] if paths_now else NULL, max_steps)
-                        if imode == PRUNE:
-                            for p in range(problem_start[s], problem_start[s + 1]):
-                                best_sum[p] += scores[p, li, 0]
-                    if l < n_layers or imode == BEAM:
-                        width = _keep(n_steps[s], n_cand, n_paths, cand, emit, need, &lays[l].search,
-                                      search_graph[s], &w)
-                        carry = need
-                        tmp_i = w.beam
-                        w.beam = w.next_beam
-                        w.next_beam = tmp_i
-                        tmp_d = w.beam_emit
-                        w.beam_emit = w.next_emit
-                        w.next_emit = tmp_d
-                if imode == BEAM:
-                    with gil:
-                        if beam_array is None:
-                            beam_array = np.full((total_steps, width), -1, dtype=np.intp)
-                            beam_out = beam_array
-                    for t in range(n_steps[s]):
-                        for r in range(width):
-                            beam_out[out_row + t, r] = w.beam[t * width + r]
-                    out_row += n_steps[s]
-                    continue
-                if imode != PRUNE:
-                    continue
-                # The sum of n_paths sequences lies between the best one and n_paths times it, at each layer.
-                top = -INFINITY
-                for p in range(problem_start[s], problem_start[s + 1]):
-                    top = max(top, best_sum[p])
-                margin = n_scored * log(<double> n_paths)
-                n_live = 0
-                for p in range(problem_start[s], problem_start[s + 1]):
-                    # kept with a margin for rounding in the sums of n_paths terms
-                    live[p] = best_sum[p] + margin >= top - 1e-9 * abs(top)
-                    n_live += live[p]
-                    if not live[p]:
-                        for li in range(n_scored):
-                            scores[p, li, 0] = -INFINITY
-                if n_live == 1:  # the winner: its best scores alone
-                    continue
-                for p in range(problem_start[s], problem_start[s + 1]):
-                    if not live[p]:
-                        continue
-                    for li in range(n_scored):
-                        l = first_scored + li
-                        paths_now = want_paths and l == n_layers
-                        _score(KBEST, n_steps[s], best_widths[li], n_paths, &lays[l], score_graph[p],
-                               w.cand + (1 + li) * max_steps * 2 * n_paths,
-                               w.emit + (1 + li) * max_steps * 2 * n_paths, &w, &scores[p, li, 0],
-                               &paths[p, 0, 0] if paths_now else NULL, max_steps)
+                if dec.n_steps[s]:
+                    _search(&dec, s)
+                    if dec.mode == PRUNE:
+                        _prune(&dec, s)
     finally:
-        _free_work(&w)
-        free(lays)
-        free(best_widths)
-        free(best_sum)
-        free(live)
-    if imode == BEAM and beam_array is None:
-        beam_array = np.full((total_steps, 1), -1, dtype=np.intp)
-    return scores_array, paths_array, beam_array
+        _release(&dec)
+    return scores_array, paths_array

@@ -16,13 +16,13 @@ its kept nodes. :func:`exhaustive_viterbi` searches all nodes of a layer, for
 reference and small problems.
 """
 
-from numbers import Integral
-
 import numpy as np
 from scipy.special import logsumexp
 
 from skmotion.tree._beam import decode_searches
+from skmotion.tree._layout import children_table, gaussian_arrays, transition_table
 from skmotion.tree._viterbi import kbest_viterbi
+from skmotion.utils._validation import check_int
 
 __all__ = ["NODE_PRIORS", "beam_decode", "exhaustive_viterbi", "node_log_posterior"]
 
@@ -35,7 +35,7 @@ _UNDERFLOW = 1e-200
 
 
 def _log_normaliser(log_po, allowed):
-    """``log sum_{j allowed in g} Po(x | j)`` for every frame and graph, ``(n_frames, n_graphs)``."""
+    """``log sum_{j allowed in g} Po(x | j)`` of every frame and graph, ``(n_frames, n_graphs)``."""
     top = log_po.max(axis=1, keepdims=True)
     weights = np.exp(log_po - top) @ allowed.T.astype(np.float64)
     with np.errstate(divide="ignore"):
@@ -143,22 +143,25 @@ _ALL_NODES = np.zeros((0, 0), dtype=np.uint8)
 
 
 def _kernel_allowed(graphs, layer, node_prior):
-    """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``, or ``(0, 0)`` for every node."""
+    """The allowed-node mask the compiled decoder reads: ``(n_graphs, K)``; ``(0, 0)``: all."""
     if node_prior == "layer":
         return _ALL_NODES
     return np.ascontiguousarray(_allowed_nodes(graphs, layer, node_prior), dtype=np.uint8)
 
 
 def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
-    """What the compiled decoder reads of layers ``1 .. layer`` (entry 0 unused); see ``decode_searches``."""
+    """What the compiled decoder reads of layers ``1 .. layer`` (entry 0 unused).
+
+    See ``decode_searches``; the per-object arrays come from :mod:`skmotion.tree._layout`.
+    """
     specs = [None]
     for depth in range(1, layer + 1):
         specs.append(
             (
-                tree.kernel_children(depth - 1),
+                children_table(tree, depth - 1),
                 tree.node_ids(depth),
-                search.kernel_table(depth),
-                scored.kernel_table(depth),
+                transition_table(search, depth),
+                transition_table(scored, depth),
                 _kernel_allowed(search, depth, node_prior),
                 _kernel_allowed(scored, depth, node_prior) if mask_scored else _ALL_NODES,
             )
@@ -166,35 +169,10 @@ def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
     return specs
 
 
-def _descend(tree, graphs, frames, frame_start, n_steps, graph, *, layer, n_paths, node_prior):
-    """Each frame's ``n_paths`` best nodes at ``layer``, ``(sum(n_steps), width)``; -1 for none.
-
-    Search ``s`` decodes ``n_steps[s]`` frames from ``frame_start[s]`` under
-    graph ``graph[s]``; its rows follow those of the searches before it.
-    """
-    n_steps = np.asarray(n_steps, dtype=np.intp)
-    if layer == 0:
-        return np.zeros((int(n_steps.sum()), 1), dtype=np.intp)
-    specs = _layer_specs(tree, graphs, graphs, layer, node_prior, False)
-    _, _, beam = decode_searches(
-        np.ascontiguousarray(frames, dtype=np.float64),
-        np.asarray(frame_start, dtype=np.intp),
-        n_steps,
-        np.asarray(graph, dtype=np.intp),
-        np.zeros(len(n_steps) + 1, dtype=np.intp),
-        np.zeros(0, dtype=np.intp),
-        tree.kernel_gaussians(),
-        specs,
-        1,
-        n_paths,
-        "beam",
-        False,
-    )
-    return beam
-
-
 def _clip_normalisers(tree, graphs, frames, offsets, clips, layers, node_prior):
-    """``sum_t log sum_j Po(x_t | j) P(j)`` of each clip, per layer and graph column: ``(n_layers, n_clips, n_cols)``.
+    """``sum_t log sum_j Po(x_t | j) P(j)`` of each clip, per layer and graph column.
+
+    Shape ``(n_layers, n_clips, n_cols)``.
 
     Only the frames of ``clips`` are evaluated.
     """
@@ -281,7 +259,8 @@ def beam_decode(
         sequences lies between the best one and ``n_paths`` times it, so a
         problem whose best sequences (summed over the scored layers) score
         more than ``n_scored log(n_paths)`` below those of another problem of
-        the same clip can never win; it gets ``-inf`` scores and -1 paths. A clip left with one problem has its winner: that problem gets
+        the same clip can never win; it gets ``-inf`` scores and -1 paths. A
+        clip left with one problem has its winner: that problem gets
         only its best sequences' scores (the others ``-inf``) and -1 paths.
         Which problem wins is unchanged.
     return_paths : bool, default=True
@@ -305,16 +284,17 @@ def beam_decode(
     >>> tree = MotionTree.build(frames, min_samples_leaf=10, max_depth=1)
     >>> graphs = TransitionGraphs.count(tree.iter_apply(frames), tree.n_nodes, offsets=[0, 40],
     ...                                 graph_of_clip=[0])
-    >>> paths, scores = beam_decode(tree, graphs, frames[18:22], [0, 4], [0], [0], layer=1, n_paths=1)
+    >>> paths, scores = beam_decode(tree, graphs, frames[18:22], [0, 4], [0], [0], layer=1,
+    ...                             n_paths=1)
     >>> paths[0].tolist(), scores.shape
     ([[0, 0, 1, 1]], (1, 1, 1))
     """
     layer = tree.check_layer(layer)
-    if not isinstance(score_layers, Integral) or isinstance(score_layers, bool) or score_layers < 1:
-        raise ValueError(f"score_layers must be an int >= 1; got {score_layers!r}.")
+    score_layers = check_int("score_layers", score_layers)
     if prune and guide is None:
         raise ValueError(
-            "prune needs a guide: the problems of a clip are compared within the clip's shared search."
+            "prune needs a guide: the problems of a clip are compared within the clip's "
+            "shared search."
         )
     offsets = np.asarray(offsets, dtype=np.intp)
     clip_of_problem = np.asarray(clip_of_problem, dtype=np.intp)
@@ -357,14 +337,14 @@ def beam_decode(
         if prune and n_paths > 1
         else "kbest"
     )
-    scores, paths, _ = decode_searches(
+    scores, paths = decode_searches(
         frames,
         offsets[search_clip],
         lengths[search_clip],
         search_graph,
         problem_start,
         score_graph,
-        tree.kernel_gaussians(),
+        gaussian_arrays(tree),
         specs,
         first,
         n_paths,

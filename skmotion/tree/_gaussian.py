@@ -241,71 +241,21 @@ class Gaussians:
             self._precisions = 1.0 / self.covariances
             log_det = d * np.log(self.covariances)
         self._const = -0.5 * (log_det + d * _LOG_2PI)
-        self._kernel = self._kernel_arrays()
 
     def __len__(self):
         return len(self.means)
 
-    def kernel_arrays(self):
-        """The arrays the compiled decoder reads (:mod:`skmotion.tree._beam`), by tree node id.
+    def precision_factors(self):
+        """``(prec, shifts, const)``: what the log densities are computed from.
 
-        Made once, with the Gaussians.
-
-        Returns
-        -------
-        arrays : dict
-            ``means`` ``(n, d)``; ``prec``: flat per-channel precisions (``"diag"``
-            and ``"spherical"``, the latter repeated over channels) or flat upper
-            triangular factors ``U`` with ``U U^T`` the precision (``"full"``);
-            ``shifts`` ``(n, d)``, ``mean @ U`` (for the other kinds an unused ``(1, 1)`` array);
-            ``const`` ``(n,)``; ``full``. For the Gaussians of ``"full"`` taken
-            in low-rank form (``floor I + V^T diag(values) V``), ``lr_start[k]``
-            is the first row of ``lr_vectors`` ``(R, d)`` of Gaussian ``k`` and
-            ``lr_rank[k]`` their count, ``lr_weights`` ``(R,)`` holds
-            ``values / (floor (floor + values))`` and ``lr_inv_floor[k]`` is
-            ``1 / floor``; ``lr_start[k]`` is -1 for the others, which use ``U``.
+        ``"full"``: the upper factors ``U`` ``(n, d, d)`` with ``U U^T`` the
+        precision, and ``mean @ U`` ``(n, d)``; the other kinds: the precisions
+        (laid out as the covariances) and None. ``const`` ``(n,)``: the log
+        normalising constants.
         """
-        return self._kernel
-
-    def _kernel_arrays(self):
-        n, d = self.means.shape
         if self.kind == "full":
-            prec, shifts = self._prec_chol, self._shifts
-        else:
-            prec = np.broadcast_to(self._precisions.reshape(n, -1), (n, d))
-            shifts = np.zeros((1, 1))
-        return {
-            "means": np.ascontiguousarray(self.means),
-            "prec": np.ascontiguousarray(prec, dtype=np.float64).ravel(),
-            "shifts": np.ascontiguousarray(shifts, dtype=np.float64),
-            "const": np.ascontiguousarray(self._const, dtype=np.float64),
-            "full": self.kind == "full",
-            **self._low_rank_arrays(),
-        }
-
-    def _low_rank_arrays(self):
-        """The low-rank form of the Gaussians where it is cheaper: ``O(r d)`` against ``O(d^2 / 2)``."""
-        n, d = self.means.shape
-        start, rank = np.full(n, -1, dtype=np.intp), np.zeros(n, dtype=np.intp)
-        inv_floor = np.zeros(n)
-        vectors, weights, row = [np.zeros((0, d))], [np.zeros(0)], 0
-        for k, parts in enumerate(
-            self.low_rank if self.kind == "full" and self.low_rank is not None else ()
-        ):
-            if parts is None or 4 * (len(parts[1]) + 2) > d:  # the triangular factor is as cheap
-                continue
-            floor, vecs, values = parts
-            start[k], rank[k], inv_floor[k] = row, len(vecs), 1.0 / floor
-            vectors.append(vecs)
-            weights.append(values / (floor * (floor + values)))
-            row += len(vecs)
-        return {
-            "lr_start": start,
-            "lr_rank": rank,
-            "lr_vectors": np.ascontiguousarray(np.vstack(vectors), dtype=np.float64),
-            "lr_weights": np.concatenate(weights),
-            "lr_inv_floor": inv_floor,
-        }
+            return self._prec_chol, self._shifts, self._const
+        return self._precisions, None, self._const
 
     def log_pdf(self, X, nodes=None):
         """Log density of every frame under every (or the chosen) Gaussian.

@@ -18,6 +18,7 @@ from skmotion.tree._transitions import TransitionGraphs
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._labels import check_label_types
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
+from skmotion.utils._validation import check_int
 
 __all__ = ["MotionTreeHMM"]
 
@@ -48,10 +49,7 @@ def _sum_of_paths(scores):
     return np.where(finite, best + np.log1p(rest), best)
 
 
-def _check_count(name, value, low=1):
-    if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
-        raise ValueError(f"{name} must be an int >= {low}; got {value!r}.")
-    return int(value)
+_check_count = check_int  # the one integer check, skmotion.utils._validation
 
 
 class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -533,86 +531,38 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             layer=layer,
         )
 
-    def plan(
-        self,
-        start,
-        goal,
-        *,
-        frame_rate,
-        body_size=None,
-        transformer=None,
-        layer=None,
-        max_frames=300,
-        tolerance=0.1,
-        start_node=None,
-        heuristic_weight=8.0,
-        cell=0.05,
-        heading_bins=36,
-        max_expansions=500_000,
-    ):
-        """Plan a motion on the global transition graph that takes the root from ``start`` to ``goal``.
+    def plan(self, start, goal, *, frame_rate, **options):
+        """Plan a motion on the global graph that takes the root from ``start`` to ``goal``.
 
         A* over (node, root pose on the floor) finds the most probable node
-        path (minimum ``-log P(path)``, the start node's frequency times the
-        transition probabilities) whose root ends within ``tolerance`` of the
-        goal, using only transitions seen in the data; the root's per-frame
-        motion in each node comes from its mean marker velocities by a damped
-        least-squares inverse of the marker Jacobian (paper 000, section V-C).
-        See :mod:`skmotion.planning` and the user guide (``docs/planning.md``).
-
-        The model must have been fit on virtual-marker clips, per marker
-        ``(px, py, pz, vx, vy, vz)`` in the body frame
-        (:class:`~skmotion.preprocessing.VirtualMarkerTransform`).
+        path whose root ends near the goal, using only transitions seen in the
+        data (Yamane, Yamaguchi and Nakamura, section V-C). The model must have been fit on
+        virtual-marker clips (:class:`~skmotion.preprocessing.VirtualMarkerTransform`).
+        The planner is :func:`skmotion.planning.plan_from_database`, which
+        checks the parameters; see the user guide (``docs/planning.md``).
 
         Parameters
         ----------
         start : tuple of (float, float, float)
-            The root's ``(x, y, heading)`` on the floor at the first frame
-            (metres, radians; ``x`` ahead and ``y`` left at heading 0).
+            The root's ``(x, y, heading)`` on the floor at the first frame.
         goal : tuple of (float, float)
             The goal position on the floor, metres.
         frame_rate : float
-            Frames per second of the training clips (velocities are per second).
-        body_size : float, default=None
-            Metres per unit of the marker data: with the transformer's default
-            size normalisation, the subject's size (ankle to head top along
-            the body) in metres. None takes it from the transformer's skeleton
-            when its units are known, else 1.0 (plan in body sizes).
-        transformer : VirtualMarkerTransform, default=None
-            The fitted transform that made the training clips. With a
-            skeleton, root motion uses the skeleton's Jacobian and the plan
-            gets joint angles (``plan.to_motion()`` for ``write_bvh``);
-            without, the rigid-body fit of all markers.
-        layer : int, default=None
-            The layer to plan at; ``layer_`` by default.
-        max_frames : int, default=300
-            The longest plan.
-        tolerance : float, default=0.1
-            The plan ends when the root is this close to the goal, metres.
-        start_node : int, default=None
-            The node of the first frame; None lets the search choose (costed
-            by the node's share of the training frames).
-        heuristic_weight : float, default=8.0
-            Weighted A*: the path's cost is at most this times the optimum
-            (1 is plain A*, optimal but slow: its lower bound of the cost
-            still to go is weak, see :func:`~skmotion.planning.astar_search`).
-        cell, heading_bins : float, int, default=0.05, 36
-            Poses closer than this (metres, heading bins) are one search state.
-        max_expansions : int, default=500000
-            After this many states the search returns the cheapest path to
-            the goal it has found, or raises when it has found none.
+            Frames per second of the training clips.
+        **options
+            ``body_size``, ``transformer``, ``layer``, ``max_frames``,
+            ``tolerance``, ``start_node``, ``heuristic_weight``, ``cell``,
+            ``heading_bins``, ``max_expansions``: see
+            :func:`~skmotion.planning.plan_from_database`.
 
         Returns
         -------
         plan : MotionPlan
-            Nodes, log probability, frames, root trajectory and, with a
-            skeleton, joint angles.
 
         Raises
         ------
         UnreachableGoalError
-            (a ``ValueError``) when no motion of the database reaches the goal
-            within ``max_frames``: the plan is never a wrong path.
+            (a ``ValueError``) when no motion of the database reaches the goal.
 
         Examples
         --------
@@ -628,76 +578,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         >>> plan.reached < 0.15, bool((plan.seen_counts > 0).all())
         (True, True)
         """
-        from skmotion.planning._plan import SkeletonModel, default_body_size, plan_motion
+        from skmotion.planning import plan_from_database
 
-        check_is_fitted(self)
-        if self.n_features_in_ % 6:
-            raise ValueError(
-                f"plan needs virtual-marker clips, 6 channels (px, py, pz, vx, vy, vz) per marker; the model has "
-                f"{self.n_features_in_} channels."
-            )
-        start = np.asarray(start, dtype=float)
-        goal = np.asarray(goal, dtype=float)
-        if start.shape != (3,) or not np.isfinite(start).all():
-            raise ValueError(f"start must be a finite (x, y, heading); got {start.tolist()!r}.")
-        if goal.shape != (2,) or not np.isfinite(goal).all():
-            raise ValueError(f"goal must be a finite (x, y); got {goal.tolist()!r}.")
-        for name, value in (
-            ("frame_rate", frame_rate),
-            ("tolerance", tolerance),
-            ("cell", cell),
-            ("heuristic_weight", heuristic_weight),
-        ):
-            if not isinstance(value, Real) or not value > 0:
-                raise ValueError(f"{name} must be a positive number; got {value!r}.")
-        if heuristic_weight < 1:
-            raise ValueError(f"heuristic_weight must be >= 1; got {heuristic_weight!r}.")
-        max_frames = _check_count("max_frames", max_frames, low=2)
-        heading_bins = _check_count("heading_bins", heading_bins)
-        max_expansions = _check_count("max_expansions", max_expansions)
-        layer = self._resolve_layer(layer)
-        n_nodes = self.tree_.n_nodes[layer]
-        if start_node is not None:
-            start_node = _check_count("start_node", start_node, low=0)
-            if start_node >= n_nodes:
-                raise ValueError(
-                    f"start_node must be below {n_nodes}, the nodes of layer {layer}; got {start_node}."
-                )
-        model = None
-        if transformer is not None:
-            check_is_fitted(transformer)
-            if len(transformer.marker_names_) * 6 != self.n_features_in_:
-                raise ValueError(
-                    f"transformer gives {6 * len(transformer.marker_names_)} channels, the model has "
-                    f"{self.n_features_in_}."
-                )
-            if transformer.skeleton is not None:
-                model = SkeletonModel.from_transformer(transformer)
-        if body_size is None:
-            body_size = default_body_size(model) or 1.0
-        elif not isinstance(body_size, Real) or not body_size > 0:
-            raise ValueError(
-                f"body_size must be a positive number (metres per data unit); got {body_size!r}."
-            )
-        graph = self.global_graph_
-        return plan_motion(
-            self.tree_.means(layer) * self.scale_ + self.center_,
-            (graph.counts(layer, 0), lambda src, dst: graph.log_prob(layer, 0, src, dst)),
-            graph.visits(layer)[0],
-            tuple(start),
-            tuple(goal),
-            frame_rate=float(frame_rate),
-            body_size=float(body_size),
-            max_frames=max_frames,
-            tolerance=float(tolerance),
-            start_node=start_node,
-            model=model,
-            heuristic_weight=float(heuristic_weight),
-            cell=float(cell),
-            heading_bins=heading_bins,
-            max_expansions=max_expansions,
-            layer=layer,
-        )
+        return plan_from_database(self, start, goal, frame_rate=frame_rate, **options)
 
     # -- a live database (skmotion.tree._partial_fit, _stream, _synthesis) -------------
 

@@ -9,25 +9,18 @@ from numbers import Integral, Real
 
 import numpy as np
 
+from skmotion.base import VersionedStateMixin
 from skmotion.tree._build import build_nodes
 from skmotion.tree._gaussian import COVARIANCE_TYPES, Gaussians
 from skmotion.tree._split import SPLIT_CRITERIA
+from skmotion.utils._validation import check_int
 
 __all__ = ["MotionTree"]
 
 _ROUTE_CHUNK = 1 << 16
 
 
-def _check_int(name, value, low, allow_none=False):
-    if allow_none and value is None:
-        return
-    if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
-        raise ValueError(
-            f"{name} must be an int >= {low}{' or None' if allow_none else ''}; got {value!r}."
-        )
-
-
-class MotionTree:
+class MotionTree(VersionedStateMixin):
     """A binary tree of frame clusters; every layer partitions all frames.
 
     Build one with :meth:`build`. Nodes are numbered in creation order
@@ -70,6 +63,11 @@ class MotionTree:
         The variance added to every covariance's diagonal.
     principal_axes : ndarray of shape (n_axes, n_channels)
         The first (up to three) principal axes of all frames, to draw nodes.
+
+    Notes
+    -----
+    A pickle records the skmotion version; loading it into an incompatible
+    version raises :class:`~skmotion.base.IncompatibleVersionError`.
 
     Examples
     --------
@@ -117,9 +115,6 @@ class MotionTree:
         self.principal_axes = principal_axes
         self.low_rank = [None] * len(parent) if low_rank is None else low_rank
         self._gaussians = Gaussians(mean, covariance, covariance_type, self.low_rank)
-        self._kernel_children = [
-            np.ascontiguousarray(self.children(layer)) for layer in range(len(layers))
-        ]
 
     @classmethod
     def build(
@@ -173,9 +168,9 @@ class MotionTree:
             raise ValueError(
                 f"frames must be finite; frame {frame}, channel {channel} is {X[frame, channel]}."
             )
-        _check_int("max_depth", max_depth, 0, allow_none=True)
-        _check_int("min_samples_split", min_samples_split, 2)
-        _check_int("min_samples_leaf", min_samples_leaf, 1)
+        check_int("max_depth", max_depth, 0, allow_none=True)
+        check_int("min_samples_split", min_samples_split, 2)
+        check_int("min_samples_leaf", min_samples_leaf, 1)
         if split not in SPLIT_CRITERIA:
             raise ValueError(f"split must be one of {SPLIT_CRITERIA}; got {split!r}.")
         if covariance_type not in COVARIANCE_TYPES:
@@ -351,13 +346,10 @@ class MotionTree:
             ids = ids[np.asarray(nodes, dtype=np.intp)]
         return self._gaussians.log_pdf(self._check_frames(frames), ids)
 
-    def kernel_gaussians(self):
-        """The nodes' Gaussians as the compiled decoder reads them (see ``Gaussians.kernel_arrays``)."""
-        return self._gaussians.kernel_arrays()
-
-    def kernel_children(self, layer):
-        """``children(layer)`` as the compiled decoder reads it: made once, C-contiguous."""
-        return self._kernel_children[self.check_layer(layer)]
+    @property
+    def gaussians(self):
+        """The nodes' Gaussians (tree node id order), which give ``log_likelihood``."""
+        return self._gaussians
 
     def _check_frames(self, frames):
         X = np.asarray(frames, dtype=np.float64)

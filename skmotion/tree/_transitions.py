@@ -22,18 +22,16 @@ from numbers import Real
 import numpy as np
 import scipy.sparse as sp
 
+from skmotion.base import VersionedStateMixin
+
 __all__ = ["TransitionGraphs"]
 
 # Graphs whose dense table (n_graphs * K * K) is at most this many entries keep
 # one, so lookups are one gather instead of a binary search.
 _DENSE_LIMIT = 1 << 21
-# The compiled decoder reads a dense table up to 8 MB, and beyond it searches the
-# short row of transitions seen from a node. On JapaneseVowels' trees a 256 KB
-# limit was slower (more searches); limits from 2 MB to 64 MB timed alike.
-_KERNEL_DENSE_LIMIT = 1 << 20
 
 
-class TransitionGraphs:
+class TransitionGraphs(VersionedStateMixin):
     """Transition counts of one or more graphs at every layer of a motion tree.
 
     Build with :meth:`count`. Graph ``g`` is the graph of the clips assigned to
@@ -53,6 +51,11 @@ class TransitionGraphs:
     n_graphs : int
     n_layers : int
     smoothing : float
+
+    Notes
+    -----
+    A pickle records the skmotion version; loading it into an incompatible
+    version raises :class:`~skmotion.base.IncompatibleVersionError`.
 
     Examples
     --------
@@ -84,7 +87,6 @@ class TransitionGraphs:
             None if d is not None else self._sorted_keys(layer)
             for layer, d in enumerate(self._dense)
         ]
-        self._kernel = [self._kernel_table(layer) for layer in range(self.n_layers)]
 
     @classmethod
     def count(cls, layer_labels, n_nodes, *, offsets, graph_of_clip, n_graphs=None, smoothing=1.0):
@@ -161,53 +163,21 @@ class TransitionGraphs:
         graph, src = np.divmod(rows, k)
         return (graph * (k + 1) + src) * (k + 1) + csr.indices
 
-    def kernel_table(self, layer):
-        """A layer's log probabilities as the compiled decoder reads them (:mod:`skmotion.tree._beam`).
+    def stacked_counts(self, layer):
+        """The counts of every graph of a layer, one sparse ``(n_graphs * K, K)`` matrix.
 
-        Made once, when the graphs are. The decoder asks for one transition in
-        every graph at once, so the values of all graphs are contiguous.
-
-        Returns
-        -------
-        table : dict
-            ``k`` (nodes) and ``n_graphs``; ``pair_start`` ``(K + 1,)``: the
-            transitions seen from node ``m`` in any graph are entries
-            ``pair_start[m]:pair_start[m + 1]``, with destinations ``pair_dst``
-            (sorted) and log probabilities ``pair_log`` ``(n_pairs, n_graphs)``
-            (a graph that never made one has its unseen value there);
-            ``unseen_log`` ``(K + 1, n_graphs)``: a never-seen transition from
-            each node, and ``-inf`` in row ``K`` ("no node"); ``dense``: the
-            flat ``(K + 1, K + 1, n_graphs)`` table of them all where it is at most
-            8 MB (a lookup without a search), else empty.
+        Graph ``g`` is rows ``g K .. (g + 1) K - 1``; indices sorted within rows.
         """
-        return self._kernel[layer]
+        return self._counts[layer]
 
-    def _kernel_table(self, layer):
-        csr = self._counts[layer]
-        k, n_graphs = self.n_nodes(layer), self.n_graphs
-        rows = np.repeat(np.arange(csr.shape[0]), np.diff(csr.indptr))
-        graph, src = np.divmod(rows, k)
-        denominator = self._totals[layer] + self.smoothing  # (n_graphs, K)
-        # The same expressions as log_prob's, so both give the same doubles.
-        unseen = np.log((0 + self.pseudo_count(layer)) / denominator)
-        pairs, pair_of_entry = np.unique(src * k + csr.indices, return_inverse=True)
-        pair_src, pair_dst = np.divmod(pairs, k)
-        pair_log = np.ascontiguousarray(unseen[:, pair_src].T)
-        pair_log[pair_of_entry, graph] = np.log(
-            (csr.data + self.pseudo_count(layer)) / denominator[graph, src]
-        )
-        small = n_graphs * (k + 1) ** 2 <= _KERNEL_DENSE_LIMIT and self._dense[layer] is not None
-        return {
-            "k": k,
-            "n_graphs": n_graphs,
-            "pair_start": np.searchsorted(pair_src, np.arange(k + 1)).astype(np.intp),
-            "pair_dst": pair_dst.astype(np.intp),
-            "pair_log": pair_log,
-            "unseen_log": np.ascontiguousarray(
-                np.vstack([unseen.T, np.full((1, n_graphs), -np.inf)])
-            ),
-            "dense": self._dense[layer] if small else np.zeros(0),
-        }
+    def log_table(self, layer):
+        """The flat ``(K + 1, K + 1, n_graphs)`` table of ``log p(src -> dst)``, or None.
+
+        Index ``K`` is "no node" (-inf); the graphs are last, so one transition's
+        values in every graph are contiguous. None when the table would exceed
+        ``2**21`` entries (``log_prob`` then looks the counts up).
+        """
+        return self._dense[layer]
 
     def n_nodes(self, layer):
         """Number of nodes of a layer."""

@@ -1,4 +1,4 @@
-"""Root velocity from body-frame markers, against rigid motions and synthetic walks of known velocity."""
+"""Root velocity from body-frame markers, against rigid motions and walks of known velocity."""
 
 import numpy as np
 import pytest

@@ -11,8 +11,10 @@ from skmotion.tree import (
     TransitionGraphs,
     beam_decode,
     exhaustive_viterbi,
+    kbest_viterbi,
     node_log_posterior,
 )
+from skmotion.tree._layout import gaussian_arrays, transition_table
 
 
 @pytest.fixture(scope="module")
@@ -99,7 +101,7 @@ def test_a_wide_beam_agrees_with_the_exhaustive_viterbi(model, prior, guided):
 def test_the_compiled_decoder_agrees_for_every_covariance_and_table(
     monkeypatch, covariance_type, dense
 ):
-    """Emissions of each covariance kind and both transition lookups, against the exhaustive Viterbi."""
+    """Emissions of each covariance kind and both transition lookups, against exhaustive Viterbi."""
     from skmotion.tree import _transitions
 
     rng = np.random.default_rng(5)
@@ -116,7 +118,7 @@ def test_the_compiled_decoder_agrees_for_every_covariance_and_table(
         graph_of_clip=[0, 1],
         smoothing=0.5,
     )
-    assert (len(graphs.kernel_table(1)["dense"]) > 0) == dense
+    assert (len(transition_table(graphs, 1)["dense"]) > 0) == dense
     clip = frames[[2, 33, 61, 80, 14]] + 0.3
     wide = int(tree.n_nodes.max())
     for graph in (0, 1):
@@ -161,29 +163,49 @@ def reference_beams(tree, graphs, clip, graph, n_paths, layer):
     return beam
 
 
+def reference_kbest_on_beams(tree, graphs, clip, graph, n_paths, layer):
+    """The numpy K-best Viterbi over the candidates the reference beams leave at ``layer``."""
+    beam = reference_beams(tree, graphs, clip, graph, n_paths, layer - 1)
+    kids = tree.children(layer - 1)
+    cand = np.array(
+        [[kids[n, side] if n >= 0 else -1 for side in (0, 1) for n in row] for row in beam]
+    )
+    log_ps = node_log_posterior(tree, graphs, layer, clip, "layer")[graph]
+    emit = np.where(cand >= 0, log_ps[np.arange(len(clip))[:, None], cand], -np.inf)
+    moves = graphs.log_prob(layer, graph, cand[:-1, :, None], cand[1:, None, :])
+    slots, scores = kbest_viterbi(emit[0][:, None], (moves + emit[1:, None, :])[..., None], n_paths)
+    paths = np.where(slots[0] >= 0, np.take_along_axis(cand.T, np.maximum(slots[0], 0), 0), -1)
+    return paths, scores[0]
+
+
 @pytest.mark.parametrize("n_paths", [1, 2, 3])
 def test_the_compiled_beams_follow_their_definition(model, n_paths):
-    from skmotion.tree._decode import _descend
+    """At each layer, the sequences decoded are the K best over the children of the beams above.
 
+    The beams are built from their definition (``reference_beams``), so a
+    wrong beam at any layer shows in the sequences or their scores.
+    """
     tree, graphs, frames = model
     rng = np.random.default_rng(n_paths)
     clip = frames[rng.integers(0, 100, size=12)] + rng.normal(scale=0.5, size=(12, 2))
     for graph in (0, 1):
         for layer in range(1, tree.n_layers):
-            beam = _descend(
+            paths, scores = beam_decode(
                 tree,
                 graphs,
                 clip,
-                np.array([0]),
-                np.array([12]),
-                np.array([graph]),
+                [0, 12],
+                [0],
+                [graph],
                 layer=layer,
                 n_paths=n_paths,
                 node_prior="layer",
             )
-            np.testing.assert_array_equal(
-                beam, reference_beams(tree, graphs, clip, graph, n_paths, layer)
+            ref_paths, ref_scores = reference_kbest_on_beams(
+                tree, graphs, clip, graph, n_paths, layer
             )
+            np.testing.assert_allclose(scores[0, 0], ref_scores, rtol=1e-12)
+            np.testing.assert_array_equal(paths[0], ref_paths)
 
 
 @pytest.mark.parametrize("n_paths", [1, 2, 3])
@@ -261,7 +283,10 @@ def test_the_normaliser_survives_underflow():
 
 
 def pruning_case(seed, score_layers):
-    """Check prune=True against prune=False; say whether clips with one and with several survivors occurred."""
+    """Check prune=True against prune=False.
+
+    Say whether clips with one and with several survivors occurred.
+    """
     rng = np.random.default_rng(seed)
     n_clips = 8
     # clips in pairs about one centre: the two graphs of a pair compete closely
@@ -332,7 +357,7 @@ def test_pruning_needs_a_guide(model):
 
 @pytest.fixture(scope="module")
 def copied_model():
-    """A minimum-error tree whose small clusters stop early: leaves copied down into lower layers."""
+    """A minimum-error tree whose small clusters stop early: leaves copied down to lower layers."""
     rng = np.random.default_rng(7)
     frames = np.vstack(
         [rng.normal(c, s, size=(n, 2)) for c, s, n in [(0, 0.3, 60), (5, 1.0, 12), (9, 0.5, 24)]]
@@ -350,7 +375,7 @@ def copied_model():
         list(tree.iter_apply(frames)), tree.n_nodes, offsets=offsets, graph_of_clip=[0, 0, 0]
     )
     copies = [
-        bool(np.isin(tree.layers[l], tree.layers[l - 1]).any()) for l in range(2, tree.n_layers)
+        bool(np.isin(tree.layers[d], tree.layers[d - 1]).any()) for d in range(2, tree.n_layers)
     ]
     assert any(copies)  # the case this fixture exists for
     return tree, graphs, guide, frames
@@ -359,7 +384,10 @@ def copied_model():
 @pytest.mark.parametrize("prior", ["graph", "layer"])
 @pytest.mark.parametrize("guided", [False, True])
 def test_every_scored_layer_agrees_with_the_exhaustive_viterbi(copied_model, prior, guided):
-    """A wide beam scoring all layers at once gives each layer's exhaustive K-best list (copied leaves too)."""
+    """A wide beam scoring all layers at once gives each layer's exhaustive K-best list.
+
+    Copied leaves too.
+    """
     tree, graphs, guide, frames = copied_model
     clip = frames[[3, 61, 80, 90, 10, 65, 30]] + 0.1
     wide = int(tree.n_nodes.max())
@@ -382,7 +410,8 @@ def test_every_scored_layer_agrees_with_the_exhaustive_viterbi(copied_model, pri
             ex_paths, ex_scores = exhaustive_viterbi(
                 tree, graphs, layer, clip, graph, n_paths=wide, node_prior=prior
             )
-            # the normaliser is subtracted as a per-clip sum: rounding is absolute, at the terms' scale
+            # the normaliser is subtracted as a per-clip sum: rounding is absolute, at the
+            # terms' scale
             np.testing.assert_allclose(scores[0, row], ex_scores, rtol=1e-12, atol=1e-9)
         finite = np.isfinite(ex_scores)
         np.testing.assert_array_equal(paths[0][finite], ex_paths[finite])
@@ -390,7 +419,10 @@ def test_every_scored_layer_agrees_with_the_exhaustive_viterbi(copied_model, pri
 
 @pytest.mark.parametrize("n_paths", [1, 2, 3])
 def test_scoring_several_layers_equals_scoring_each_alone(copied_model, n_paths):
-    """Beams above a layer do not depend on which layers are scored: each row is that layer's own decode."""
+    """Beams above a layer do not depend on which layers are scored.
+
+    Each row is that layer's own decode.
+    """
     tree, graphs, guide, frames = copied_model
     rng = np.random.default_rng(n_paths)
     clips = [
@@ -437,14 +469,14 @@ def test_score_layers_stop_at_layer_one(model):
 
 
 def test_low_rank_covariances_decode_as_the_full_factor():
-    """Nodes with fewer frames than channels take the compiled O(r d) form; the reference uses Cholesky."""
+    """Nodes with fewer frames than channels take the compiled O(r d) form; reference: Cholesky."""
     rng = np.random.default_rng(11)
     d = 48
     frames = np.vstack([rng.normal(c, 1.0, size=(24, d)) for c in (0.0, 2.0, 4.0)])
     tree = MotionTree.build(
         frames, max_depth=3, min_samples_leaf=4, split="median", covariance_type="full"
     )
-    low = tree.kernel_gaussians()["lr_start"] >= 0
+    low = gaussian_arrays(tree)["lr_start"] >= 0
     assert low.any() and not low.all()  # both forms are exercised
     graphs = TransitionGraphs.count(
         list(tree.iter_apply(frames)),

@@ -8,6 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from skmotion.tree import TransitionGraphs, _transitions
+from skmotion.tree._layout import transition_table
 
 
 def loop_counts(labels, offsets, graph_of_clip, n_graphs, k):
@@ -123,9 +124,11 @@ def test_smoothing_must_be_positive():
         )
 
 
-def test_the_kernel_table_holds_every_log_probability(monkeypatch, rng):
-    """The compiled decoder's lookups (dense table, or a pair's row of every graph and the unseen rows) give
-    log_prob exactly."""
+def test_the_decoder_table_holds_every_log_probability(monkeypatch, rng):
+    """The compiled decoder's lookups give log_prob exactly.
+
+    Both the dense table and, without it, a pair's row of every graph and the unseen rows.
+    """
     dense, sparse = dense_and_sparse(
         monkeypatch,
         rng.integers(0, 6, size=150),
@@ -135,7 +138,7 @@ def test_the_kernel_table_holds_every_log_probability(monkeypatch, rng):
         smoothing=0.7,
     )
     for graphs, has_dense in ((dense, True), (sparse, False)):
-        table = graphs.kernel_table(0)
+        table = transition_table(graphs, 0)
         k, n_graphs = table["k"], table["n_graphs"]
         assert (k, n_graphs, len(table["dense"]) > 0) == (6, 3, has_dense)
         assert np.isneginf(table["unseen_log"][k]).all()  # "no node"
