@@ -69,7 +69,9 @@ def test_string_labels_and_probabilities(motions):
     log_prob = model.score_samples(X[:6])
     proba = model.predict_proba(X[:6])
     np.testing.assert_allclose(proba.sum(axis=1), 1.0)
-    np.testing.assert_allclose(proba, np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True)))
+    # per-frame generation probabilities over the fitted temperature, then a softmax
+    scaled = log_prob / np.array([len(c) for c in X[:6]])[:, None] / model.temperature_
+    np.testing.assert_allclose(proba, np.exp(scaled - logsumexp(scaled, axis=1, keepdims=True)))
     np.testing.assert_array_equal(model.predict(X[:6]), model.classes_[log_prob.argmax(axis=1)])
 
 
@@ -281,8 +283,9 @@ def test_several_scored_layers_multiply_their_generation_probabilities(motions):
     expected = np.sum([m.score_samples(X[1::3]) for m in per_layer], axis=0)
     np.testing.assert_allclose(model.score_samples(X[1::3]), expected, rtol=1e-10)
     log_prob = model.score_samples(X[:5])
+    scaled = log_prob / np.array([len(c) for c in X[:5]])[:, None] / model.temperature_
     np.testing.assert_allclose(
-        model.predict_proba(X[:5]), np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True))
+        model.predict_proba(X[:5]), np.exp(scaled - logsumexp(scaled, axis=1, keepdims=True))
     )
 
 

@@ -1,0 +1,90 @@
+"""Clip histograms over a motion tree's nodes: occupancy per temporal-pyramid cell and transitions.
+
+Free functions on routed node labels (see :class:`TreeRouter`), used by
+:class:`MotionTreeEncoder`. All clips are handled together: each frame adds one
+entry per (layer, pyramid level) to a sparse matrix whose duplicates sum into
+the histograms.
+"""
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["feature_blocks", "histogram_features"]
+
+
+def feature_blocks(layers, n_nodes, pyramid, transition_layers):
+    """The blocks of the feature vector, in order: ``(kind, layer, parts, width)``.
+
+    ``kind`` is ``"occupancy"`` (one block per layer and pyramid level, ``parts``
+    cells of ``n_nodes[layer]`` columns) or ``"transitions"`` (``parts`` is 1,
+    ``n_nodes[layer] ** 2`` columns).
+    """
+    blocks = [
+        ("occupancy", int(layer), int(parts), int(n_nodes[layer]) * int(parts))
+        for layer in layers
+        for parts in pyramid
+    ]
+    blocks += [
+        ("transitions", int(layer), 1, int(n_nodes[layer]) ** 2) for layer in transition_layers
+    ]
+    return blocks
+
+
+def histogram_features(nodes, offsets, layers, blocks, power):
+    """Per-clip normalised histograms of routed frames, as a CSR matrix.
+
+    Parameters
+    ----------
+    nodes : ndarray of shape (n_frames, n_layers_routed)
+        Layer index of every frame's node, for the layers ``layers``.
+    offsets : ndarray of shape (n_clips + 1,)
+        Clip ``i`` is frames ``offsets[i]:offsets[i + 1]``.
+    layers : sequence of int
+        The layer of each column of ``nodes``.
+    blocks : list of tuple
+        From :func:`feature_blocks`.
+    power : float
+        Every entry is raised to this power (0.5: Hellinger's square root).
+
+    Returns
+    -------
+    features : scipy.sparse.csr_matrix of shape (n_clips, n_features)
+        Occupancy cell ``c`` of ``parts`` holds the share of the clip's frames
+        ``[c n / parts, (c + 1) n / parts)`` in each node (each cell sums to 1
+        before ``power``); a transition entry is the share of the clip's
+        ``n - 1`` steps that go from one node to another (staying is not
+        counted: occupancy says it).
+    """
+    n_clips = len(offsets) - 1
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(n_clips), lengths)
+    position = np.arange(offsets[-1]) - offsets[clip]
+    column_of = {layer: j for j, layer in enumerate(layers)}
+    rows, cols, vals = [], [], []
+    start = 0
+    for kind, layer, parts, width in blocks:
+        node = nodes[:, column_of[layer]]
+        k = width // parts if kind == "occupancy" else int(np.sqrt(width))
+        if kind == "occupancy":
+            cell = position * parts // lengths[clip]
+            key = clip * parts + cell
+            size = np.bincount(key, minlength=n_clips * parts)
+            rows.append(clip)
+            cols.append(start + cell * k + node)
+            vals.append(1.0 / size[key])
+        else:
+            same_clip = position[:-1] + 1 < lengths[clip[:-1]]
+            step = np.flatnonzero(same_clip & (node[:-1] != node[1:]))
+            src_clip = clip[step]
+            rows.append(src_clip)
+            cols.append(start + node[step] * k + node[step + 1])
+            vals.append(1.0 / (lengths[src_clip] - 1))
+        start += width
+    matrix = sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(n_clips, start),
+    )
+    matrix.sum_duplicates()
+    if power != 1:
+        np.power(matrix.data, power, out=matrix.data)
+    return matrix
