@@ -5,6 +5,7 @@ writes a CSV and a Markdown table to ``benchmarks/results/`` (git-ignored).
 """
 
 import csv
+import os
 import platform
 import statistics
 import sys
@@ -15,7 +16,12 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 RESULTS = Path(__file__).resolve().parent / "results"
-SHARED_DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data"
+# As in tests/conftest.py: SKMOTION_SHARED_DATA points elsewhere (e.g. from a git worktree).
+SHARED_DATA = Path(
+    os.environ.get(
+        "SKMOTION_SHARED_DATA", Path(__file__).resolve().parents[1].parent / "shared" / "data"
+    )
+)
 
 
 def time_call(func, *, repeats=5, warmup=1):
@@ -31,7 +37,7 @@ def time_call(func, *, repeats=5, warmup=1):
 
 
 def interleaved(funcs, rounds):
-    """Median seconds of each function, timed in alternation so that they share the machine's load."""
+    """Median seconds of each function, timed in alternation (they share the machine's load)."""
     for func in funcs:
         func()  # warm-up
     times = [[] for _ in funcs]

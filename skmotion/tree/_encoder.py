@@ -3,15 +3,17 @@
 from numbers import Integral, Real
 
 import numpy as np
+import scipy.sparse as sp
 from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
-from skmotion.tree._histograms import feature_blocks, histogram_features
+from skmotion.tree._histograms import feature_blocks, histogram_features, residual_features
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._routing import TreeRouter
 from skmotion.tree._split import SPLIT_CRITERIA
 from skmotion.utils._clips import check_clips, stack_clips
+from skmotion.utils._features import channel_names_in
 from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
@@ -57,6 +59,12 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     transition_layers : array-like of int, default=()
         Layers whose node-to-node steps are counted (``n_nodes ** 2`` columns
         each, so coarse layers).
+    residual_layers : array-like of int, default=(1, 3)
+        Layers whose nodes also report where the clip's frames sit within
+        them: per node, the mean offset of the clip's frames from the node's
+        mean (standardised units, ``n_nodes * n_channels`` dense columns per
+        layer; a VLAD code), each layer's block scaled to unit norm. Occupancy
+        alone loses this continuous detail.
     power : float, default=0.5
         Every histogram entry is raised to this power; 1 keeps the shares.
     standardize : bool, default=True
@@ -78,6 +86,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         The encoded layers.
     transition_layers_ : ndarray of int
         The layers whose transitions are encoded.
+    residual_layers_ : ndarray of int
+        The layers whose residuals are encoded.
     center_, scale_ : ndarray of shape (n_features_in_,)
         The standardisation.
     n_features_out_ : int
@@ -107,9 +117,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     >>> from skmotion.tree import MotionTreeEncoder
     >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
     >>> X = [clip[:, 6:] for clip in data.clips]
-    >>> encoder = MotionTreeEncoder(max_depth=3, pyramid=[1, 2]).fit(X)
+    >>> encoder = MotionTreeEncoder(max_depth=3, pyramid=[1, 2], residual_layers=[1]).fit(X)
     >>> encoder.transform(X).shape, encoder.get_feature_names_out()[:2].tolist()
-    ((8, 42), ['layer1_node0_part1of1', 'layer1_node1_part1of1'])
+    ((8, 162), ['layer1_node0_part1of1', 'layer1_node1_part1of1'])
     >>> model = make_pipeline(MotionTreeEncoder(), LogisticRegression()).fit(X, data.target)
     >>> model.score(X, data.target)
     1.0
@@ -122,6 +132,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         "layers": [StrOptions({"all"}), "array-like"],
         "pyramid": ["array-like"],
         "transition_layers": ["array-like"],
+        "residual_layers": ["array-like"],
         "power": [Interval(Real, 0, 1, closed="right")],
         "standardize": ["boolean"],
         "sparse_output": ["boolean", StrOptions({"auto"})],
@@ -138,6 +149,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         layers="all",
         pyramid=(1, 2, 3),
         transition_layers=(),
+        residual_layers=(1, 3),
         power=0.5,
         standardize=True,
         sparse_output="auto",
@@ -149,6 +161,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self.layers = layers
         self.pyramid = pyramid
         self.transition_layers = transition_layers
+        self.residual_layers = residual_layers
         self.power = power
         self.standardize = standardize
         self.sparse_output = sparse_output
@@ -192,11 +205,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         bottom = self.tree_.n_layers - 1
         wanted = range(1, bottom + 1) if _is_all(self.layers) else _int_list("layers", self.layers)
         self.layers_ = np.array(sorted({v for v in wanted if v <= bottom}), dtype=np.intp)
-        transitions = _int_list("transition_layers", self.transition_layers)
-        self.transition_layers_ = np.array(
-            sorted({v for v in transitions if v <= bottom}), dtype=np.intp
-        )
-        if len(self.layers_) == 0 and len(self.transition_layers_) == 0:
+        self.transition_layers_ = _existing("transition_layers", self.transition_layers, bottom)
+        self.residual_layers_ = _existing("residual_layers", self.residual_layers, bottom)
+        if not (len(self.layers_) or len(self.transition_layers_) or len(self.residual_layers_)):
             raise ValueError(
                 f"None of layers={self.layers!r} exists in the tree (layers 1 to {bottom}); "
                 "nothing to encode."
@@ -206,7 +217,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self._blocks = feature_blocks(
             self.layers_, self.tree_.n_nodes, pyramid, self.transition_layers_
         )
-        self.n_features_out_ = sum(width for *_, width in self._blocks)
+        self.n_features_out_ = sum(width for *_, width in self._blocks) + int(
+            self.tree_.n_nodes[self.residual_layers_].sum() * self.n_features_in_
+        )
         return self
 
     def transform(self, X):
@@ -230,10 +243,29 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                 f"{self.n_features_out_} columns as a sparse matrix: set sparse_output=False."
             )
         frames, offsets = stack_clips(clips)
-        routed = np.union1d(self.layers_, self.transition_layers_)
+        routed = np.union1d(
+            np.union1d(self.layers_, self.transition_layers_), self.residual_layers_
+        )
         nodes = self._router.route(frames, routed)
         features = histogram_features(nodes, offsets, routed, self._blocks, self.power)
-        return features if sparse else self._wrap_table(features.toarray(), clips)
+        if len(self.residual_layers_):
+            residuals = residual_features(
+                (frames - self.center_) / self.scale_,
+                nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                offsets,
+                self.residual_layers_,
+                [self.tree_.means(layer) for layer in self.residual_layers_],
+                self.power,
+            )
+            if sparse:
+                features = sp.hstack([features, sp.csr_matrix(residuals)], format="csr")
+            else:
+                features = np.hstack([features.toarray(), residuals])
+        if sparse:
+            return features
+        return self._wrap_table(
+            features if isinstance(features, np.ndarray) else features.toarray(), clips
+        )
 
     def _sparse(self):
         if self.sparse_output == "auto":
@@ -241,12 +273,15 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         return bool(self.sparse_output)
 
     def get_feature_names_out(self, input_features=None):
-        """Names ``layer<l>_node<k>_part<c>of<p>`` and ``layer<l>_node<a>_to_node<b>``.
+        """Column names: each names its layer, node and pyramid cell (or step, or channel).
+
+        ``layer<l>_node<k>_part<c>of<p>`` (occupancy), ``layer<l>_node<a>_to_node<b>``
+        (transitions), ``layer<l>_node<k>_<channel>`` (residuals).
 
         Parameters
         ----------
-        input_features : None
-            Ignored (the features are tree nodes, not channels).
+        input_features : array-like of str, default=None
+            Input channel names (for the residual columns).
 
         Returns
         -------
@@ -265,11 +300,23 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             else:
                 k = int(round(np.sqrt(width)))
                 names += [f"layer{layer}_node{a}_to_node{b}" for a in range(k) for b in range(k)]
+        channels = channel_names_in(self, input_features)
+        for layer in self.residual_layers_:
+            names += [
+                f"layer{layer}_node{k}_{c}"
+                for k in range(self.tree_.n_nodes[layer])
+                for c in channels
+            ]
         return np.asarray(names, dtype=object)
 
 
 def _is_all(value):
     return isinstance(value, str) and value == "all"
+
+
+def _existing(name, values, bottom):
+    """The layers of ``values`` that the tree has, sorted, without repeats."""
+    return np.array(sorted({v for v in _int_list(name, values) if v <= bottom}), dtype=np.intp)
 
 
 def _int_list(name, values, low=0):

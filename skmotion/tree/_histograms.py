@@ -9,11 +9,11 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["feature_blocks", "histogram_features"]
+__all__ = ["feature_blocks", "histogram_features", "residual_features"]
 
 
 def feature_blocks(layers, n_nodes, pyramid, transition_layers):
-    """The blocks of the feature vector, in order: ``(kind, layer, parts, width)``.
+    """The sparse blocks of the feature vector, in order: ``(kind, layer, parts, width)``.
 
     ``kind`` is ``"occupancy"`` (one block per layer and pyramid level, ``parts``
     cells of ``n_nodes[layer]`` columns) or ``"transitions"`` (``parts`` is 1,
@@ -88,3 +88,49 @@ def histogram_features(nodes, offsets, layers, blocks, power):
     if power != 1:
         np.power(matrix.data, power, out=matrix.data)
     return matrix
+
+
+def residual_features(z, nodes, offsets, layers, means, power):
+    """Per clip and node, the mean offset of the clip's frames from the node's mean (VLAD).
+
+    For each layer, ``sum_{t in node k} (z_t - mean_k) / n_frames`` for every
+    node ``k`` (zeros where the clip has no frame), raised to ``power`` with
+    its sign, and the layer's block scaled to unit Euclidean norm (so every
+    layer weighs alike, whatever its node count). Where occupancy says which
+    poses a clip visits, this says how its frames sit within them: the
+    continuous detail a partition loses.
+
+    Parameters
+    ----------
+    z : ndarray of shape (n_frames, n_channels)
+        Standardised frames.
+    nodes : ndarray of shape (n_frames, n_layers)
+        Layer index of every frame's node in each of ``layers``.
+    offsets : ndarray of shape (n_clips + 1,)
+    layers : sequence of int
+    means : list of ndarray of shape (n_nodes(layer), n_channels)
+        The nodes' mean frames (standardised), per layer.
+    power : float
+
+    Returns
+    -------
+    features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
+    """
+    n_clips, n_frames = len(offsets) - 1, len(z)
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(n_clips), lengths)
+    blocks = []
+    for j, mean in enumerate(means):
+        k = len(mean)
+        node = nodes[:, j]
+        # (clip, node) x frame averaging matrix: one sparse product sums every group
+        average = sp.csr_matrix(
+            (1.0 / lengths[clip], (clip * k + node, np.arange(n_frames))),
+            shape=(n_clips * k, n_frames),
+        )
+        block = (average @ (z - mean[node])).reshape(n_clips, -1)
+        if power != 1:
+            block = np.sign(block) * np.abs(block) ** power
+        norm = np.linalg.norm(block, axis=1, keepdims=True)
+        blocks.append(block / np.where(norm > 0, norm, 1.0))
+    return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))

@@ -85,7 +85,17 @@ def reference_features(encoder, clips):
                 if nodes[t] != nodes[t + 1]:
                     table[nodes[t], nodes[t + 1]] += 1.0 / (n - 1)
             parts_out.append(table.ravel())
-        rows.append(np.concatenate(parts_out) ** encoder.power)
+        hist = np.concatenate(parts_out) ** encoder.power
+        residuals = []
+        for layer in encoder.residual_layers_:
+            nodes = tree.apply(z, layer)
+            means = tree.means(layer)
+            block = np.zeros_like(means)
+            for t in range(n):
+                block[nodes[t]] += (z[t] - means[nodes[t]]) / n
+            block = np.sign(block) * np.abs(block) ** encoder.power
+            residuals.append(block.ravel() / np.linalg.norm(block))
+        rows.append(np.concatenate([hist, *residuals]))
     return np.array(rows)
 
 
@@ -93,14 +103,21 @@ def test_features_match_a_per_clip_loop(motions):
     X = motions[0][:12]
     X = X + [X[0][:2], X[1][:1]]  # clips shorter than the pyramid's cells
     encoder = MotionTreeEncoder(
-        max_depth=4, pyramid=[1, 2, 3], transition_layers=[2], power=0.5, sparse_output=False
+        max_depth=4,
+        pyramid=[1, 2, 3],
+        transition_layers=[2],
+        residual_layers=[1, 3],
+        power=0.5,
+        sparse_output=False,
     ).fit(X)
     np.testing.assert_allclose(encoder.transform(X), reference_features(encoder, X), atol=1e-12)
 
 
 def test_each_cell_is_a_distribution_and_names_follow_the_columns(motions):
     X = motions[0][:10]
-    encoder = MotionTreeEncoder(max_depth=3, pyramid=[1, 2], power=1.0, sparse_output=False)
+    encoder = MotionTreeEncoder(
+        max_depth=3, pyramid=[1, 2], residual_layers=[], power=1.0, sparse_output=False
+    )
     features = encoder.fit_transform(X)
     names = encoder.get_feature_names_out()
     assert len(names) == features.shape[1] == encoder.n_features_out_
@@ -151,7 +168,9 @@ def test_pickled_encoder_gives_identical_features(motions):
 def test_cells_partition_every_clip(lengths, parts):
     rng = np.random.default_rng(len(lengths) * 7 + parts)
     train = [rng.normal(size=(50, 3)) for _ in range(3)]
-    encoder = MotionTreeEncoder(max_depth=2, pyramid=[parts], power=1.0, sparse_output=False)
+    encoder = MotionTreeEncoder(
+        max_depth=2, pyramid=[parts], residual_layers=[], power=1.0, sparse_output=False
+    )
     encoder.fit(train)
     clips = [rng.normal(size=(n, 3)) for n in lengths]
     features = encoder.transform(clips)
@@ -164,7 +183,7 @@ def test_cells_partition_every_clip(lengths, parts):
     [
         ({"pyramid": []}, "pyramid must name"),
         ({"pyramid": [0]}, "pyramid must hold ints >= 1"),
-        ({"layers": [9]}, "nothing to encode"),
+        ({"layers": [9], "residual_layers": []}, "nothing to encode"),
     ],
 )
 def test_bad_parameters_are_named(params, match, motions):
