@@ -80,6 +80,8 @@ def histogram_features(nodes, offsets, layers, blocks, power):
             cols.append(start + node[step] * k + node[step + 1])
             vals.append(1.0 / (lengths[src_clip] - 1))
         start += width
+    if not blocks:
+        return sp.csr_matrix((n_clips, 0))
     matrix = sp.csr_matrix(
         (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
         shape=(n_clips, start),
