@@ -64,18 +64,22 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     Parameters
     ----------
-    max_depth : int, default=10
+    max_depth : int, default=8
         The deepest layer of the tree (the root is layer 0); None for no limit
-        (the paper's choice). Decoding costs one pass per layer, and
-        minimum-error splits can grow very deep trees, hence the default.
+        (the paper's choice). Decoding costs one pass per layer.
     min_samples_split : int, default=2
         A node with fewer frames is not split.
-    min_samples_leaf : int, default=16
-        A split is only made when both sides keep this many frames.
-    split : {"min_error", "two_means", "median"}, default="min_error"
-        How a node's projections on its first principal axis are cut:
-        Kittler-Illingworth minimum-error thresholding (the paper's), 1-D
-        2-means, or the median (balanced trees).
+    min_samples_leaf : int, default=4
+        A split is only made when both sides keep this many frames (the
+        paper's databases use 16).
+    split : {"two_means", "median", "min_error"}, default="two_means"
+        How a node's projections on its first principal axis are cut: 1-D
+        2-means, the median (balanced trees), or Kittler-Illingworth
+        minimum-error thresholding (the paper's, which cuts off small tails
+        and grows deep, unbalanced trees). The defaults of ``split``,
+        ``max_depth``, ``min_samples_leaf`` and ``score_layers`` were the most
+        accurate candidates on every development data set (the user guide's
+        table); :data:`PAPER_SETTINGS` gives the paper's.
     covariance_type : {"diag", "full", "spherical"}, default="diag"
         The covariance estimator of each node; ``"full"`` is Ledoit-Wolf shrunk.
     reg_covar : float, default=1e-6
@@ -104,7 +108,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     layer : int, default=None
         The layer to classify at (negative counts from the bottom); None for
         the bottom layer. Upper layers are faster and coarser.
-    score_layers : int or "all", default=1
+    score_layers : int or "all", default="all"
         How many layers, ending at ``layer``, classify together: a clip's score
         under a graph is the product of its generation probabilities at each
         of them (a product of experts over the tree's resolutions; the paper
@@ -231,10 +235,10 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     def __init__(
         self,
         *,
-        max_depth=10,
+        max_depth=8,
         min_samples_split=2,
-        min_samples_leaf=16,
-        split="min_error",
+        min_samples_leaf=4,
+        split="two_means",
         covariance_type="diag",
         reg_covar=1e-6,
         graph="class",
@@ -242,7 +246,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         smoothing=1.0,
         n_paths=3,
         layer=None,
-        score_layers=1,
+        score_layers="all",
         standardize=True,
         calibration_cv=3,
         verbose=0,

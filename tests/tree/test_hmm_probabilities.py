@@ -137,3 +137,25 @@ def test_verbose_reports_the_stages_and_default_is_silent(split, capsys):
     MotionTreeHMM(max_depth=3, verbose=1).fit(Xtr, ytr)
     err = capsys.readouterr().err
     assert "building the tree" in err and "transition graphs" in err and "calibration" in err
+
+
+def test_the_papers_recipe_builds_the_papers_model(split):
+    """MotionTreeHMM(**PAPER_SETTINGS): minimum-error splits without depth limit, clip graphs."""
+    from skmotion.tree import PAPER_SETTINGS
+
+    Xtr, ytr, Xte, yte = split
+    paper = MotionTreeHMM(**PAPER_SETTINGS)
+    assert {k: paper.get_params()[k] for k in PAPER_SETTINGS} == PAPER_SETTINGS
+    assert MotionTreeHMM().split != paper.split  # the defaults are the measured ones
+    paper.fit(Xtr[::2], ytr[::2])
+    tree = paper.tree_
+    # every split node kept at least 16 frames on each side; one graph per training clip
+    split_nodes = tree.left >= 0
+    assert (tree.count[tree.left[split_nodes]] >= 16).all()
+    assert (tree.count[tree.right[split_nodes]] >= 16).all()
+    assert len(paper.graph_classes_) == len(Xtr[::2])
+    assert paper.tree_.covariance_type == "full" and (paper.scale_ == 1).all()
+    # no depth limit: the tree stops only where a node cannot be cut into two leaves of 16
+    leaves = np.flatnonzero(~split_nodes)
+    assert paper.n_layers_ - 1 == tree.depth[leaves].max() and paper.n_layers_ > 9
+    assert set(paper.predict(Xte)) <= set(paper.classes_)
