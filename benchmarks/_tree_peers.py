@@ -10,13 +10,12 @@ from skmotion.preprocessing import ResampleClips
 from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
 
 ENCODER_GRID = {
-    "motiontreeencoder__max_depth": [6, 8, 10],
-    "motiontreeencoder__pyramid": [(1,), (1, 2, 3)],
-    "motiontreeencoder__residual_layers": [(), (1, 3)],
+    "motiontreeencoder__layers": [(), "all"],
+    "motiontreeencoder__residual_layers": [(1, 3), (0, 1, 2, 3), (2, 4)],
     "logisticregression__C": [1.0, 10.0],
 }
 QUICK_ENCODER_GRID = {
-    "motiontreeencoder__max_depth": [6, 8],
+    "motiontreeencoder__residual_layers": [(1, 3), (0, 1, 2, 3)],
     "logisticregression__C": [1.0, 10.0],
 }
 
@@ -83,34 +82,38 @@ def probability_scores(y, proba, classes):
 # -- the defaults study -----------------------------------------------------------------
 
 HMM_CANDIDATES = {
-    "min_error, depth 10, diag, score_layers=1 (former defaults)": dict(
+    "min_error, depth 10, leaf 16, score_layers=1 (former defaults)": dict(
         split="min_error", max_depth=10, score_layers=1, min_samples_leaf=16
     ),
-    "median, depth 8, diag, score_layers='all'": dict(
+    "median, depth 8, leaf 16, all layers": dict(
         split="median", max_depth=8, score_layers="all", min_samples_leaf=16
     ),
-    "median, depth 8, diag, score_layers='all', leaf 4": dict(
+    "median, depth 8, leaf 4, all layers": dict(
         split="median", max_depth=8, score_layers="all", min_samples_leaf=4
     ),
-    "two_means, depth 8, diag, score_layers='all', leaf 4": dict(
+    "median, depth 6, leaf 16, all layers": dict(
+        split="median", max_depth=6, score_layers="all", min_samples_leaf=16
+    ),
+    "two_means, depth 8, leaf 4, all layers (defaults)": dict(
         split="two_means", max_depth=8, score_layers="all", min_samples_leaf=4
     ),
-    "median, depth 6, diag, score_layers='all'": dict(
-        split="median", max_depth=6, score_layers="all", min_samples_leaf=16
+    "two_means, depth 8, leaf 4, 3 layers": dict(
+        split="two_means", max_depth=8, score_layers=3, min_samples_leaf=4
     ),
 }
 ENCODER_CANDIDATES = {
-    "occupancy, depth 8, pyramid 1-2-3": dict(residual_layers=()),
-    "occupancy, depth 10, pyramid 1-2-3": dict(max_depth=10, residual_layers=()),
-    "residuals of layers 1, 3 only": dict(layers=[], residual_layers=(1, 3)),
-    "occupancy depth 8, pyramid 1-2-3 + residuals 1, 3": dict(),
-    "occupancy depth 8, pyramid 1 + residuals 1, 3": dict(pyramid=(1,)),
-    "occupancy depth 10, pyramid 1-2-3 + residuals 1, 3": dict(max_depth=10),
+    "occupancy, depth 8, pyramid 1-2-3": dict(layers="all", residual_layers=()),
+    "occupancy, depth 8, pyramid 1": dict(layers="all", pyramid=(1,), residual_layers=()),
+    "occupancy depth 8, pyramid 1-2-3 + residuals 1, 3": dict(layers="all"),
+    "occupancy depth 8, pyramid 1 + residuals 1, 3": dict(layers="all", pyramid=(1,)),
+    "residuals of layers 1, 3 (defaults)": dict(),
+    "residuals of layers 0-3": dict(residual_layers=(0, 1, 2, 3)),
+    "residuals of layers 2, 4": dict(residual_layers=(2, 4)),
 }
 
 
 def defaults_study(name, data, splits, quick):
-    """CV accuracy on the training set and test accuracy of each candidate default."""
+    """Test accuracy (and, unless quick, CV accuracy on training) of each candidate default."""
     Xtr, ytr, Xte, yte, _ = data
     rows = []
     candidates = [("MotionTreeHMM", k, v) for k, v in HMM_CANDIDATES.items()]
@@ -122,14 +125,15 @@ def defaults_study(name, data, splits, quick):
             model = MotionTreeHMM(calibration_cv=None, **params)
         else:
             model = encoder_pipeline(**params)
-        cv = cross_val_score(model, Xtr, ytr, cv=splits[:5] if quick else splits, n_jobs=2)
+        cv = "" if quick else float(cross_val_score(model, Xtr, ytr, cv=splits, n_jobs=2).mean())
         rows.append(
             {
                 "dataset": name,
                 "model": model_name,
                 "candidate": label,
-                "CV accuracy (train)": float(cv.mean()),
+                "CV accuracy (train)": cv,
                 "test accuracy": float(model.fit(Xtr, ytr).score(Xte, yte)),
             }
         )
+        print(rows[-1], flush=True)
     return rows

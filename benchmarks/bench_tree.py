@@ -601,7 +601,7 @@ DEFAULTS_NOTES = (
     "Candidate defaults of MotionTreeHMM (calibration_cv=None: labels do not depend on it) and of "
     "MotionTreeEncoder (into LogisticRegression(C=1)): accuracy by cross-validation on the "
     "training set "
-    "(the recognition table's folds) and on the test set."
+    "(the recognition table's folds; not in the quick run) and on the test set."
 )
 ENCODER_SPEED_NOTES = (
     "MotionTreeEncoder() fit on 40-frame windows (hop 20) of the synthetic motions' first 20 "

@@ -19,7 +19,7 @@ from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["MotionTreeEncoder"]
 
-# "auto" gives a sparse matrix from this many output columns on.
+# "auto" gives a sparse matrix from this many occupancy and transition columns on.
 _SPARSE_FROM = 1024
 
 
@@ -42,17 +42,20 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     Parameters
     ----------
     max_depth : int, default=8
-        The deepest layer of the tree (root: layer 0).
+        The deepest layer of the tree (root: layer 0). The tree is only built
+        as deep as the deepest layer encoded (layer 3 with the defaults).
     min_samples_leaf : int, default=4
         A split is only made when both sides keep this many frames.
     split : {"median", "two_means", "min_error"}, default="median"
         How a node's frames are cut on their first principal axis (see
         :meth:`MotionTree.build`); the median gives balanced trees, whose
         layers make even vocabularies.
-    layers : "all" or array-like of int, default="all"
+    layers : "all" or array-like of int, default=()
         The layers whose occupancy is encoded; ``"all"`` is every layer but
         the root (whose occupancy is always 1). Layers deeper than the tree
-        are left out.
+        are left out. None by default: in the measurements behind the
+        defaults, occupancy added nothing to the residuals on any data set and
+        cost accuracy on JapaneseVowels (user guide).
     pyramid : array-like of int, default=(1, 2, 3)
         Temporal pyramid: for each ``p``, occupancy over each ``1/p`` of the
         clip (1: the whole clip).
@@ -71,10 +74,10 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         Scale every channel to zero mean and unit variance (training frames)
         before the tree's principal axes are found.
     sparse_output : bool or "auto", default="auto"
-        Return a ``scipy.sparse`` CSR matrix; ``"auto"`` does when the output
-        has at least 1024 columns. ``set_output(transform="pandas")`` needs
-        dense output: it raises a ``ValueError`` otherwise (pandas has no
-        efficient sparse frames for this).
+        Return a ``scipy.sparse`` CSR matrix; ``"auto"`` does when the
+        occupancy and transition columns (mostly zeros) number at least 1024.
+        ``set_output(transform="pandas")`` needs dense output: it raises a
+        ``ValueError`` otherwise (pandas has no efficient sparse frames for this).
     verbose : int, default=0
         0 is silent; 1 or more reports the tree's build on standard error.
 
@@ -117,7 +120,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     >>> from skmotion.tree import MotionTreeEncoder
     >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
     >>> X = [clip[:, 6:] for clip in data.clips]
-    >>> encoder = MotionTreeEncoder(max_depth=3, pyramid=[1, 2], residual_layers=[1]).fit(X)
+    >>> encoder = MotionTreeEncoder(max_depth=3, layers="all", pyramid=[1, 2], residual_layers=[1])
+    >>> encoder = encoder.fit(X)
     >>> encoder.transform(X).shape, encoder.get_feature_names_out()[:2].tolist()
     ((8, 162), ['layer1_node0_part1of1', 'layer1_node1_part1of1'])
     >>> model = make_pipeline(MotionTreeEncoder(), LogisticRegression()).fit(X, data.target)
@@ -146,7 +150,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         max_depth=8,
         min_samples_leaf=4,
         split="median",
-        layers="all",
+        layers=(),
         pyramid=(1, 2, 3),
         transition_layers=(),
         residual_layers=(1, 3),
@@ -197,7 +201,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         say(self.verbose, f"MotionTreeEncoder: building the tree over {len(frames):,} frames")
         self.tree_ = MotionTree.build(
             (frames - self.center_) / self.scale_,
-            max_depth=self.max_depth,
+            max_depth=self._build_depth(),
             min_samples_leaf=self.min_samples_leaf,
             split=self.split,
             covariance_type="spherical",  # routing uses the splits only
@@ -209,14 +213,16 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self.residual_layers_ = _existing("residual_layers", self.residual_layers, bottom)
         if not (len(self.layers_) or len(self.transition_layers_) or len(self.residual_layers_)):
             raise ValueError(
-                f"None of layers={self.layers!r} exists in the tree (layers 1 to {bottom}); "
-                "nothing to encode."
+                f"None of layers={self.layers!r}, transition_layers={self.transition_layers!r}, "
+                f"residual_layers={self.residual_layers!r} exists in the tree (layers 0 to "
+                f"{bottom}); nothing to encode."
             )
         self._pyramid = pyramid
         self._router = TreeRouter(self.tree_, self.center_, self.scale_)
         self._blocks = feature_blocks(
             self.layers_, self.tree_.n_nodes, pyramid, self.transition_layers_
         )
+        self._residual_means = [self.tree_.means(layer) for layer in self.residual_layers_]
         self.n_features_out_ = sum(width for *_, width in self._blocks) + int(
             self.tree_.n_nodes[self.residual_layers_].sum() * self.n_features_in_
         )
@@ -250,11 +256,12 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         features = histogram_features(nodes, offsets, routed, self._blocks, self.power)
         if len(self.residual_layers_):
             residuals = residual_features(
-                (frames - self.center_) / self.scale_,
+                frames,
                 nodes[:, np.searchsorted(routed, self.residual_layers_)],
                 offsets,
-                self.residual_layers_,
-                [self.tree_.means(layer) for layer in self.residual_layers_],
+                self._residual_means,
+                self.center_,
+                self.scale_,
                 self.power,
             )
             if sparse:
@@ -267,9 +274,20 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             features if isinstance(features, np.ndarray) else features.toarray(), clips
         )
 
+    def _build_depth(self):
+        """The deepest layer any block reads (a deeper tree would be built for nothing)."""
+        if _is_all(self.layers):
+            return self.max_depth
+        wanted = [
+            *_int_list("layers", self.layers),
+            *_int_list("transition_layers", self.transition_layers),
+            *_int_list("residual_layers", self.residual_layers),
+        ]
+        return min(self.max_depth, max(wanted, default=1))
+
     def _sparse(self):
         if self.sparse_output == "auto":
-            return self.n_features_out_ >= _SPARSE_FROM
+            return sum(width for *_, width in self._blocks) >= _SPARSE_FROM
         return bool(self.sparse_output)
 
     def get_feature_names_out(self, input_features=None):

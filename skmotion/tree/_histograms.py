@@ -92,45 +92,48 @@ def histogram_features(nodes, offsets, layers, blocks, power):
     return matrix
 
 
-def residual_features(z, nodes, offsets, layers, means, power):
+def residual_features(frames, nodes, offsets, means, center, scale, power):
     """Per clip and node, the mean offset of the clip's frames from the node's mean (VLAD).
 
     For each layer, ``sum_{t in node k} (z_t - mean_k) / n_frames`` for every
-    node ``k`` (zeros where the clip has no frame), raised to ``power`` with
-    its sign, and the layer's block scaled to unit Euclidean norm (so every
-    layer weighs alike, whatever its node count). Where occupancy says which
-    poses a clip visits, this says how its frames sit within them: the
-    continuous detail a partition loses.
+    node ``k`` (zeros where the clip has no frame), with ``z = (x - center) /
+    scale``, raised to ``power`` with its sign, and the layer's block scaled to
+    unit Euclidean norm (so every layer weighs alike, whatever its node count).
+    Where occupancy says which poses a clip visits, this says how its frames
+    sit within them: the continuous detail a partition loses.
 
     Parameters
     ----------
-    z : ndarray of shape (n_frames, n_channels)
-        Standardised frames.
+    frames : ndarray of shape (n_frames, n_channels)
+        Raw frames (the standardisation is applied to the sums).
     nodes : ndarray of shape (n_frames, n_layers)
-        Layer index of every frame's node in each of ``layers``.
+        Layer index of every frame's node in each encoded layer.
     offsets : ndarray of shape (n_clips + 1,)
-    layers : sequence of int
     means : list of ndarray of shape (n_nodes(layer), n_channels)
         The nodes' mean frames (standardised), per layer.
+    center, scale : ndarray of shape (n_channels,)
     power : float
 
     Returns
     -------
     features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
     """
-    n_clips, n_frames = len(offsets) - 1, len(z)
+    n_clips, n_frames = len(offsets) - 1, len(frames)
     lengths = np.diff(offsets)
     clip = np.repeat(np.arange(n_clips), lengths)
+    weight = 1.0 / lengths[clip]
     blocks = []
     for j, mean in enumerate(means):
         k = len(mean)
-        node = nodes[:, j]
-        # (clip, node) x frame averaging matrix: one sparse product sums every group
+        group = clip * k + nodes[:, j]
+        # (clip, node) x frame averaging matrix: one sparse product sums every group of raw
+        # frames; sum (x - c) / s - mean = (sum x - share c) / s - share mean, share = sum 1 / n
         average = sp.csr_matrix(
-            (1.0 / lengths[clip], (clip * k + node, np.arange(n_frames))),
-            shape=(n_clips * k, n_frames),
+            (weight, (group, np.arange(n_frames))), shape=(n_clips * k, n_frames)
         )
-        block = (average @ (z - mean[node])).reshape(n_clips, -1)
+        share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
+        block = ((average @ frames - share * center) / scale).reshape(n_clips, k, -1)
+        block = (block - share.reshape(n_clips, k, 1) * mean).reshape(n_clips, -1)
         if power != 1:
             block = np.sign(block) * np.abs(block) ** power
         norm = np.linalg.norm(block, axis=1, keepdims=True)

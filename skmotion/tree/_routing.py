@@ -3,9 +3,10 @@
 :class:`TreeRouter` folds a standardisation into the split axes and thresholds,
 so raw frames are routed without a standardised copy, and walks all frames of
 a collection down the tree together: one step per layer, none per clip or frame.
-A step projects the frames on their nodes' split axes: for a layer of few
-split nodes by one matrix product with all of them (BLAS), else by gathering
-each frame's own axis (the product would do work for every node).
+A step compares each frame's projection on its node's split axis with the
+threshold. The axes of all layers with few split nodes are applied in one
+matrix product (BLAS, one read of the frames); a deeper layer gathers each
+frame's own axis (a product would do work for every node).
 """
 
 import numpy as np
@@ -13,9 +14,8 @@ import numpy as np
 __all__ = ["TreeRouter"]
 
 # Split nodes of a layer up to which all frames are projected on all of its axes at once:
-# beyond it the per-frame gather costs less than the product's extra columns (measured,
-# 120 channels).
-_DENSE_PROJECTION_LIMIT = 24
+# beyond it the per-frame gather costs less than the product's extra columns.
+_DENSE_LIMIT = 24
 _CHUNK = 1 << 15  # frames per block: bounds the (frames x axes) product's memory
 
 
@@ -84,33 +84,35 @@ class TreeRouter:
     def _route_block(self, frames, layers):
         out = np.empty((len(frames), len(layers)), dtype=np.intp)
         node = np.zeros(len(frames), dtype=np.intp)  # tree node ids, from the root
-        column = 0
+        # The split axes of the upper layers (few nodes each) in one product: one read of frames.
+        upper = [ids for ids in self.split_ids[: layers[-1]] if 0 < len(ids) <= _DENSE_LIMIT]
+        column = np.full(len(self.left), -1, dtype=np.intp)
+        proj = None
+        if upper:
+            ids = np.concatenate(upper)
+            column[ids] = np.arange(len(ids))
+            proj = frames @ self.axis[ids].T
+        k = 0
         for layer in range(layers[-1] + 1):
-            if layer == layers[column]:
-                out[:, column] = self.layer_index[layer, node]
-                column += 1
+            if layer == layers[k]:
+                out[:, k] = self.layer_index[layer, node]
+                k += 1
             if layer == layers[-1]:
                 break
-            node = self._step(frames, node, layer)
+            node = self._step(frames, node, layer, proj, column)
         return out
 
-    def _step(self, frames, node, layer):
+    def _step(self, frames, node, layer, proj, column):
         """Every frame's node one layer down (a leaf copied down stays itself)."""
-        split_ids = self.split_ids[layer]
-        if len(split_ids) == 0:
+        splits = self.left[node] >= 0
+        if not splits.any():
             return node
-        if len(split_ids) <= _DENSE_PROJECTION_LIMIT:
-            position = np.full(len(self.left), -1, dtype=np.intp)
-            position[split_ids] = np.arange(len(split_ids))
-            col = position[node]
-            proj = frames @ self.axis[split_ids].T
-            splits = col >= 0
-            right = np.take_along_axis(proj, np.maximum(col, 0)[:, None], axis=1)[:, 0]
-            right = splits & (right > self.threshold[node])
+        rows = np.flatnonzero(splits)
+        ids = node[rows]
+        if proj is not None and column[ids[0]] >= 0:  # this layer's axes are in the product
+            values = proj[rows, column[ids]]
         else:
-            splits = self.left[node] >= 0
-            rows = np.flatnonzero(splits)
-            right = np.zeros(len(frames), dtype=bool)
-            ids = node[rows]
-            right[rows] = np.einsum("ij,ij->i", frames[rows], self.axis[ids]) > self.threshold[ids]
+            values = np.einsum("ij,ij->i", frames[rows], self.axis[ids])
+        right = np.zeros(len(frames), dtype=bool)
+        right[rows] = values > self.threshold[ids]
         return np.where(splits, np.where(right, self.right[node], self.left[node]), node)

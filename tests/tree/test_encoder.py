@@ -34,7 +34,7 @@ def motions():
 @parametrize_with_clip_checks(
     [
         ClipCase(
-            MotionTreeEncoder(max_depth=3, sparse_output=False),
+            MotionTreeEncoder(max_depth=3, layers="all", sparse_output=False),
             small_motions,
             param_grid={"max_depth": [2, 3], "power": [0.5, 1.0]},
         )
@@ -104,6 +104,7 @@ def test_features_match_a_per_clip_loop(motions):
     X = X + [X[0][:2], X[1][:1]]  # clips shorter than the pyramid's cells
     encoder = MotionTreeEncoder(
         max_depth=4,
+        layers="all",
         pyramid=[1, 2, 3],
         transition_layers=[2],
         residual_layers=[1, 3],
@@ -116,7 +117,12 @@ def test_features_match_a_per_clip_loop(motions):
 def test_each_cell_is_a_distribution_and_names_follow_the_columns(motions):
     X = motions[0][:10]
     encoder = MotionTreeEncoder(
-        max_depth=3, pyramid=[1, 2], residual_layers=[], power=1.0, sparse_output=False
+        max_depth=3,
+        layers="all",
+        pyramid=[1, 2],
+        residual_layers=[],
+        power=1.0,
+        sparse_output=False,
     )
     features = encoder.fit_transform(X)
     names = encoder.get_feature_names_out()
@@ -138,9 +144,12 @@ def test_each_cell_is_a_distribution_and_names_follow_the_columns(motions):
 
 def test_sparse_and_pandas_output(motions):
     X = motions[0][:10]
-    big = MotionTreeEncoder(max_depth=8, min_samples_leaf=1).fit(X)
+    big = MotionTreeEncoder(max_depth=8, min_samples_leaf=1, layers="all").fit(X)
     assert big.n_features_out_ >= 1024 and sp.issparse(big.transform(X))
-    dense = MotionTreeEncoder(max_depth=8, min_samples_leaf=1, sparse_output=False).fit(X)
+    dense = MotionTreeEncoder(
+        max_depth=8, min_samples_leaf=1, layers="all", sparse_output=False
+    ).fit(X)
+    assert not sp.issparse(MotionTreeEncoder().fit(X).transform(X))  # residuals: dense
     np.testing.assert_array_equal(big.transform(X).toarray(), dense.transform(X))
     big.set_output(transform="pandas")
     with pytest.raises(ValueError, match="sparse_output=False"):
@@ -161,7 +170,9 @@ def test_pickled_encoder_gives_identical_features(motions):
     X = motions[0][:10]
     encoder = MotionTreeEncoder().fit(X)
     again = pickle.loads(pickle.dumps(encoder))
-    assert (encoder.transform(X) != again.transform(X)).nnz == 0
+    np.testing.assert_array_equal(encoder.transform(X), again.transform(X))
+    sparse = MotionTreeEncoder(layers="all", sparse_output=True).fit(X)
+    assert (sparse.transform(X) != pickle.loads(pickle.dumps(sparse)).transform(X)).nnz == 0
 
 
 @given(st.lists(st.integers(1, 60), min_size=1, max_size=6), st.integers(1, 5))
@@ -169,7 +180,12 @@ def test_cells_partition_every_clip(lengths, parts):
     rng = np.random.default_rng(len(lengths) * 7 + parts)
     train = [rng.normal(size=(50, 3)) for _ in range(3)]
     encoder = MotionTreeEncoder(
-        max_depth=2, pyramid=[parts], residual_layers=[], power=1.0, sparse_output=False
+        max_depth=2,
+        layers="all",
+        pyramid=[parts],
+        residual_layers=[],
+        power=1.0,
+        sparse_output=False,
     )
     encoder.fit(train)
     clips = [rng.normal(size=(n, 3)) for n in lengths]
@@ -184,6 +200,7 @@ def test_cells_partition_every_clip(lengths, parts):
         ({"pyramid": []}, "pyramid must name"),
         ({"pyramid": [0]}, "pyramid must hold ints >= 1"),
         ({"layers": [9], "residual_layers": []}, "nothing to encode"),
+        ({"layers": [], "residual_layers": []}, "nothing to encode"),
     ],
 )
 def test_bad_parameters_are_named(params, match, motions):
