@@ -2,16 +2,21 @@
 
 Result tables, all measured in one run on the same splits:
 
-- ``tree_recognition``: test accuracy and predict throughput (whole clips, every
-  class scored) of MotionTreeHMM, hmmlearn ``GaussianHMM`` per class, 1-NN DTW
+- ``tree_recognition``: test accuracy, log loss, expected calibration error and
+  predict time per clip (whole clips, every class scored) of MotionTreeHMM (CV-chosen
+  and defaults), MotionTreeEncoder + LogisticRegression (CV-chosen and defaults),
+  hmmlearn ``GaussianHMM`` per class, aeon ``MiniRocketClassifier``, 1-NN DTW
   (tslearn) and 1-NN Euclidean on resampled clips, on BasicMotions and
-  JapaneseVowels (the archive's train/test split) and on the synthetic motions
-  (subjects 0-2 train, subject 3 test; the 60 joint-angle channels without the
-  root), and on CMU subject 02's trials cut into 1 s windows of virtual markers
-  (split by time inside each trial, see :func:`cmu_windows`). Every model's hyperparameters are
-  chosen by cross-validation on the
-  training set only (stratified 5-fold repeated three times, or by subject for
-  the synthetic data).
+  JapaneseVowels (the archive's train/test split), the synthetic motions as joint
+  angles and as body-frame marker positions (subjects 0-2 train, subject 3 test),
+  and CMU subject 02's trials cut into 1 s windows of virtual markers (split by
+  time inside each trial, see :func:`cmu_windows`). Every model's hyperparameters
+  are chosen by cross-validation on the training set only (stratified 5-fold,
+  repeated three times unless ``--quick``, or by subject for the synthetic data).
+- ``tree_defaults``: the study behind the defaults of MotionTreeHMM and
+  MotionTreeEncoder (candidates' test accuracy; also CV accuracy unless ``--quick``).
+- ``tree_encoder_speed``: MotionTreeEncoder's transform time per 40-frame clip of
+  120 channels.
 - ``tree_score_layers``: accuracy against the tree's depth when one, three or all
   layers are scored (``score_layers``), on BasicMotions and JapaneseVowels.
 - ``tree_selection`` (only with ``--only selection``, about 25 minutes): the
@@ -24,9 +29,10 @@ Result tables, all measured in one run on the same splits:
   with ``min_samples_leaf=16``) on the data at hand and on CMU subjects 01-03
   (virtual markers), and the time of one decode at each layer.
 
-Run: ``python benchmarks/bench_tree.py`` (``--quick`` for a smoke run). Needs
-the ``bench`` extra (hmmlearn, tslearn); the UEA and CMU rows need ``../shared/data``
-and are left out, with a message, without it.
+Run: ``python benchmarks/bench_tree.py`` (``--quick``: small grids, single 5-fold;
+``--only TABLE``). Needs the ``bench`` extra (hmmlearn, tslearn, aeon); the UEA and
+CMU rows need ``../shared/data`` (or ``SKMOTION_SHARED_DATA``) and are left out,
+with a message, without it.
 """
 
 import argparse
@@ -574,28 +580,23 @@ def layer_table(datasets, quick):
 
 
 RECOGNITION_NOTES = (
-    "Hyperparameters of every model chosen by CV on the training set only (stratified 5-fold "
-    "repeated three "
-    "times, the same splits for every model; subject-wise 3-fold for the synthetic data): "
-    "MotionTreeHMM by "
-    "GridSearchCV over n_paths, score_layers, split, max_depth, min_samples_leaf, covariance_type "
-    "and smoothing "
-    "(on CMU: n_paths, score_layers, split, max_depth, covariance_type); hmmlearn's state count. "
-    "Predict time: "
-    "median over runs of the whole test set, every class scored, MotionTreeHMM's models and "
-    "hmmlearn timed in "
-    "alternation; 'throughput vs hmmlearn' is hmmlearn's time over the method's. CMU subject 02: "
-    "virtual markers (32 markers, positions and velocities, 192 channels) at 30 Hz, 1 s windows "
-    "with a 0.5 s hop; "
-    "each trial cut at 60% of its frames, training windows before the cut and test windows after "
-    "it (split by "
-    "time inside each trial: no window overlaps across train and test); 6 classes (walk, jump, "
-    "punch, bend, "
-    "swordplay, wash; run/jog's only trial, 1.4 s, is too short for both sides). Its CV folds "
-    "(stratified 5-fold "
-    "on the training windows, repeated) share overlapping windows, which can only flatter the CV "
-    "scores used to choose, "
-    "never the test accuracy."
+    "Hyperparameters of every model chosen by CV on the training set only (stratified 5-fold, "
+    "repeated three times unless --quick, the same splits for every model; subject-wise 3-fold "
+    "for the synthetic data): MotionTreeHMM by GridSearchCV over n_paths, score_layers, split, "
+    "max_depth, min_samples_leaf, covariance_type and smoothing (on CMU a smaller grid; --quick: "
+    "split, max_depth, covariance_type); the encoder pipeline over layers, residual_layers and "
+    "LogisticRegression's C (--quick: residual_layers and C); hmmlearn's state count; "
+    "MiniRocket: default kernels, its ridge's alpha by leave-one-out on the training set. "
+    "Probabilities: MotionTreeHMM's predict_proba (temperature fitted by internal CV), the "
+    "encoder's LogisticRegression, hmmlearn's softmax of per-class log-likelihoods, MiniRocket's "
+    "predict_proba (one-hot: its ridge classifier gives no probabilities); log loss with "
+    "probabilities clipped at 1e-15, ECE over 10 bins of the top probability. Predict time: "
+    "median over runs of the whole test set, every model timed in alternation (the machine is "
+    "shared: ratios count, not times). CMU subject 02: virtual markers (32 markers, positions "
+    "and velocities, 192 channels) at 30 Hz, 1 s windows with a 0.5 s hop; each trial cut at 60% "
+    "of its frames, training windows before the cut and test windows after it; 6 classes (walk, "
+    "jump, punch, bend, swordplay, wash). Its CV folds share overlapping windows, which can only "
+    "flatter the CV scores used to choose, never the test accuracy."
 )
 DEFAULTS_NOTES = (
     "Candidate defaults of MotionTreeHMM (calibration_cv=None: labels do not depend on it) and of "
@@ -673,12 +674,13 @@ def main():
     else:
         print(f"CMU: not found in {SHARED_DATA}, its rows are left out")
     if args.only in (None, "recognition"):
-        rows = [
-            row
-            for name, loader in loaders.items()
-            for row in recognition(name, loader, args.quick)[0]
-        ]
-        write_results("tree_recognition", rows, notes=RECOGNITION_NOTES)
+        rows = []
+        for (
+            name,
+            loader,
+        ) in loaders.items():  # written after each data set: a long run keeps its rows
+            rows += recognition(name, loader, args.quick)[0]
+            write_results("tree_recognition", rows, notes=RECOGNITION_NOTES)
     if args.only in (None, "defaults"):
         rows = []
         for name, loader in loaders.items():
