@@ -253,26 +253,25 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             np.union1d(self.layers_, self.transition_layers_), self.residual_layers_
         )
         nodes = self._router.route(frames, routed)
-        features = histogram_features(nodes, offsets, routed, self._blocks, self.power)
+        parts = []
+        if self._blocks:
+            parts.append(histogram_features(nodes, offsets, routed, self._blocks, self.power))
         if len(self.residual_layers_):
-            residuals = residual_features(
-                frames,
-                nodes[:, np.searchsorted(routed, self.residual_layers_)],
-                offsets,
-                self._residual_means,
-                self.center_,
-                self.scale_,
-                self.power,
+            parts.append(
+                residual_features(
+                    frames,
+                    nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                    offsets,
+                    self._residual_means,
+                    self.center_,
+                    self.scale_,
+                    self.power,
+                )
             )
-            if sparse:
-                features = sp.hstack([features, sp.csr_matrix(residuals)], format="csr")
-            else:
-                features = np.hstack([features.toarray(), residuals])
         if sparse:
-            return features
-        return self._wrap_table(
-            features if isinstance(features, np.ndarray) else features.toarray(), clips
-        )
+            return sp.hstack(parts, format="csr") if len(parts) > 1 else sp.csr_matrix(parts[0])
+        dense = [p.toarray() if sp.issparse(p) else p for p in parts]
+        return self._wrap_table(dense[0] if len(dense) == 1 else np.hstack(dense), clips)
 
     def _build_depth(self):
         """The deepest layer any block reads (a deeper tree would be built for nothing)."""
