@@ -159,3 +159,12 @@ def test_the_papers_recipe_builds_the_papers_model(split):
     leaves = np.flatnonzero(~split_nodes)
     assert paper.n_layers_ - 1 == tree.depth[leaves].max() and paper.n_layers_ > 9
     assert set(paper.predict(Xte)) <= set(paper.classes_)
+
+
+def test_novelty_of_extreme_clips_is_the_lowest_score_without_warnings(split):
+    model, held_out, _ = _novelty_case()
+    scores = model.novelty_score(
+        [c * 1e300 for c in held_out[:2]] + [c + 1e6 for c in held_out[:2]]
+    )
+    assert np.isneginf(scores[:2]).all()  # the density underflows: as novel as it gets
+    assert np.isfinite(scores[2:]).all() and scores[2:].max() < model.novelty_score(held_out).min()
