@@ -663,6 +663,11 @@ def main():
         ],
         help="run one table only (selection, about 25 minutes, runs only when asked)",
     )
+    parser.add_argument(
+        "--data",
+        action="append",
+        help="only the data sets whose name contains this (repeatable); results get a suffix",
+    )
     args = parser.parse_args()
     loaders = {
         "synthetic (subject 3 held out)": synthetic,
@@ -680,14 +685,16 @@ def main():
         loaders["CMU subject 02, 1 s windows (split by time)"] = cmu_windows
     else:
         print(f"CMU: not found in {SHARED_DATA}, its rows are left out")
+    suffix = ""
+    if args.data:
+        loaders = {k: v for k, v in loaders.items() if any(d in k for d in args.data)}
+        suffix = "_" + "_".join(d.replace(" ", "-") for d in args.data)
     if args.only in (None, "recognition"):
         rows = []
-        for (
-            name,
-            loader,
-        ) in loaders.items():  # written after each data set: a long run keeps its rows
+        # written after each data set: a long run keeps its rows
+        for name, loader in loaders.items():
             rows += recognition(name, loader, args.quick)[0]
-            write_results("tree_recognition", rows, notes=RECOGNITION_NOTES)
+            write_results("tree_recognition" + suffix, rows, notes=RECOGNITION_NOTES)
     if args.only in (None, "defaults"):
         rows = []
         for name, loader in loaders.items():
