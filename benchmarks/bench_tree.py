@@ -2,15 +2,21 @@
 
 Result tables, all measured in one run on the same splits:
 
-- ``tree_recognition``: test accuracy and predict throughput (whole clips, every
-  class scored) of MotionTreeHMM, hmmlearn ``GaussianHMM`` per class, 1-NN DTW
+- ``tree_recognition``: test accuracy, log loss, expected calibration error and
+  predict time per clip (whole clips, every class scored) of MotionTreeHMM (CV-chosen
+  and defaults), MotionTreeEncoder + LogisticRegression (CV-chosen and defaults),
+  hmmlearn ``GaussianHMM`` per class, aeon ``MiniRocketClassifier``, 1-NN DTW
   (tslearn) and 1-NN Euclidean on resampled clips, on BasicMotions and
-  JapaneseVowels (the archive's train/test split) and on the synthetic motions
-  (subjects 0-2 train, subject 3 test; the 60 joint-angle channels without the
-  root), and on CMU subject 02's trials cut into 1 s windows of virtual markers
-  (split by time inside each trial, see :func:`cmu_windows`). Every model's hyperparameters are chosen by cross-validation on the
-  training set only (stratified 5-fold repeated three times, or by subject for
-  the synthetic data).
+  JapaneseVowels (the archive's train/test split), the synthetic motions as joint
+  angles and as body-frame marker positions (subjects 0-2 train, subject 3 test),
+  and CMU subject 02's trials cut into 1 s windows of virtual markers (split by
+  time inside each trial, see :func:`cmu_windows`). Every model's hyperparameters
+  are chosen by cross-validation on the training set only (stratified 5-fold,
+  repeated three times unless ``--quick``, or by subject for the synthetic data).
+- ``tree_defaults``: the study behind the defaults of MotionTreeHMM and
+  MotionTreeEncoder (candidates' test accuracy; also CV accuracy unless ``--quick``).
+- ``tree_encoder_speed``: MotionTreeEncoder's transform time per 40-frame clip of
+  120 channels.
 - ``tree_score_layers``: accuracy against the tree's depth when one, three or all
   layers are scored (``score_layers``), on BasicMotions and JapaneseVowels.
 - ``tree_selection`` (only with ``--only selection``, about 25 minutes): the
@@ -23,9 +29,10 @@ Result tables, all measured in one run on the same splits:
   with ``min_samples_leaf=16``) on the data at hand and on CMU subjects 01-03
   (virtual markers), and the time of one decode at each layer.
 
-Run: ``python benchmarks/bench_tree.py`` (``--quick`` for a smoke run). Needs
-the ``bench`` extra (hmmlearn, tslearn); the UEA and CMU rows need ``../shared/data``
-and are left out, with a message, without it.
+Run: ``python benchmarks/bench_tree.py`` (``--quick``: small grids, single 5-fold;
+``--only TABLE``). Needs the ``bench`` extra (hmmlearn, tslearn, aeon); the UEA and
+CMU rows need ``../shared/data`` (or ``SKMOTION_SHARED_DATA``) and are left out,
+with a message, without it.
 """
 
 import argparse
@@ -38,6 +45,15 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA, interleaved, time_call, write_results  # noqa: E402
+from _tree_peers import (  # noqa: E402
+    ENCODER_GRID,
+    QUICK_ENCODER_GRID,
+    MiniRocket,
+    defaults_study,
+    encoder_pipeline,
+    probability_scores,
+    softmax_scores,
+)
 from sklearn.cluster import BisectingKMeans  # noqa: E402
 from sklearn.model_selection import (
     GridSearchCV,
@@ -50,9 +66,10 @@ from sklearn.pipeline import make_pipeline  # noqa: E402
 
 from skmotion.datasets import load_uea, make_motions  # noqa: E402
 from skmotion.preprocessing import FlattenClips, ResampleClips  # noqa: E402
-from skmotion.tree import MotionTree, MotionTreeHMM  # noqa: E402
+from skmotion.tree import MotionTree, MotionTreeEncoder, MotionTreeHMM  # noqa: E402
 
-# n_paths=1 and score_layers=1 come first: among equally accurate settings GridSearchCV keeps the first.
+# n_paths=1 and score_layers=1 come first: among equally accurate settings GridSearchCV keeps the
+# first.
 TREE_GRID = {
     "n_paths": [1, 3],
     "score_layers": [1, 3, "all"],
@@ -93,6 +110,27 @@ def synthetic():
     return pick(train), names[train], pick(~train), names[~train], data.groups[train]
 
 
+def synthetic_positions():
+    """The synthetic motions as marker positions: body frame (hip-centred, facing), size-normalised.
+
+    The positions (not the velocities) of VirtualMarkerTransform's 32 markers,
+    96 channels, like a Kinect-style tracker's joints after hip-centring and
+    size normalisation; subject 3 held out.
+    """
+    from skmotion.io import as_motions
+    from skmotion.preprocessing import VirtualMarkerTransform
+
+    data = make_motions(random_state=0)
+    motions = as_motions(data.clips, data.skeletons, data.frame_rate)
+    markers = VirtualMarkerTransform().fit_transform(motions)
+    n = markers[0].shape[1] // 6
+    positions = [m.reshape(len(m), n, 6)[:, :, :3].reshape(len(m), -1) for m in markers]
+    train = data.groups < 3
+    pick = lambda mask: [c for c, m in zip(positions, mask) if m]  # noqa: E731
+    names = data.target_names[data.target]
+    return pick(train), names[train], pick(~train), names[~train], data.groups[train]
+
+
 CMU_RATE = 30  # Hz, after the markers are computed at the recorded 120 Hz
 CMU_WINDOW, CMU_HOP, CMU_TRAIN_SHARE = 30, 15, 0.6  # frames at 30 Hz: 1 s windows, 0.5 s hop
 # Subject 02's trials by activity (cmu-index.csv descriptions, shortened)
@@ -108,7 +146,7 @@ CMU_CLASSES = {
 
 
 def cmu_markers(subjects):
-    """Virtual-marker clips (192 channels) of CMU subjects at 30 Hz, with their Bunch; None without the data."""
+    """Virtual-marker clips (192 channels) of CMU subjects at 30 Hz, with their Bunch (or None)."""
     from skmotion.datasets import load_cmu_asfamc
     from skmotion.preprocessing import to_markers
 
@@ -145,15 +183,16 @@ def cmu_windows():
     return (*pick(Xtr, ytr), *pick(Xte, yte), None)
 
 
-def cv_for(y, groups):
+def cv_for(y, groups, quick=False):
     """Subject-wise folds where subjects are known, else stratified 5-fold repeated three times.
 
     One 5-fold split leaves the choice among hundreds of near-equal settings to
     the luck of its folds; three shuffles of it average that out (for every model).
+    The quick run repeats it once.
     """
     if groups is not None:
         return GroupKFold(3)
-    return RepeatedStratifiedKFold(n_splits=5, n_repeats=3, random_state=0)
+    return RepeatedStratifiedKFold(n_splits=5, n_repeats=1 if quick else 3, random_state=0)
 
 
 # -- the peers ---------------------------------------------------------------------------
@@ -226,32 +265,49 @@ def dtw_1nn():
 
 def recognition(name, loader, quick):
     Xtr, ytr, Xte, yte, groups = loader()
-    cv = cv_for(ytr, groups)
+    cv = cv_for(ytr, groups, quick)
     splits = list(cv.split(Xtr, ytr, groups))
 
     grid = QUICK_TREE_GRID if quick else CMU_TREE_GRID if name.startswith("CMU") else TREE_GRID
     search = GridSearchCV(MotionTreeHMM(), grid, cv=splits, n_jobs=2)
     search.fit(Xtr, ytr)
     tree = search.best_estimator_
-    # Variants of the chosen model: the fastest beam, diagonal covariances (the hmmlearn peer's), the paper's
-    # single scored layer, and its node prior.
-    changes = [
-        ("n_paths=1", {"n_paths": 1}),
-        ("covariance_type='diag'", {"covariance_type": "diag"}),
-        ("score_layers=1 (the paper's)", {"score_layers": 1}),
-        ("node_prior='graph' (the paper's)", {"node_prior": "graph"}),
-    ]
-    variants = [("", tree)] + [
-        (f", {label}", MotionTreeHMM(**{**search.best_params_, **change}).fit(Xtr, ytr))
+    # Variants of the chosen model: the defaults, the fastest beam, diagonal covariances (hmmlearn's
+    # peer's), the paper's single scored layer, and its node prior.
+    changes = [("MotionTreeHMM() defaults", None)]
+    if not quick:
+        changes += [
+            ("MotionTreeHMM, n_paths=1", {"n_paths": 1}),
+            ("MotionTreeHMM, covariance_type='diag'", {"covariance_type": "diag"}),
+            ("MotionTreeHMM, score_layers=1 (the paper's)", {"score_layers": 1}),
+            ("MotionTreeHMM, node_prior='graph' (the paper's)", {"node_prior": "graph"}),
+        ]
+    variants = [("MotionTreeHMM (CV-chosen)", tree)] + [
+        (
+            label,
+            MotionTreeHMM(**({**search.best_params_, **change} if change else {})).fit(Xtr, ytr),
+        )
         for label, change in changes
-        if any(tree.get_params()[k] != v for k, v in change.items())  # not the same model
+        if change is None or any(tree.get_params()[k] != v for k, v in change.items())
+    ]
+
+    encoder_grid = QUICK_ENCODER_GRID if quick else ENCODER_GRID
+    encoder_search = GridSearchCV(encoder_pipeline(), encoder_grid, cv=splits, n_jobs=2)
+    encoder_search.fit(Xtr, ytr)
+    encoders = [
+        ("MotionTreeEncoder + LogisticRegression (CV-chosen)", encoder_search.best_estimator_),
+        ("MotionTreeEncoder() + LogisticRegression() defaults", encoder_pipeline().fit(Xtr, ytr)),
     ]
 
     n_states = choose_hmm(Xtr, ytr, splits)
     hmm = PerClassHMM(n_states).fit(Xtr, ytr)
+    rocket = MiniRocket().fit(Xtr, ytr)
+    models = variants + encoders
     # Timed in alternation, so that all share the machine's load alike.
-    *tree_s, hmm_s = interleaved(
-        [lambda m=m: m.predict(Xte) for _, m in variants] + [lambda: hmm.scores(Xte)], REPEATS
+    *model_s, hmm_s, rocket_s = interleaved(
+        [lambda m=m: m.predict(Xte) for _, m in models]
+        + [lambda: hmm.scores(Xte), lambda: rocket.predict(Xte)],
+        REPEATS,
     )
 
     length = int(np.median([len(x) for x in Xtr]))
@@ -263,35 +319,93 @@ def recognition(name, loader, quick):
     dtw_s, _ = time_call(lambda: dtw.predict(Xte), repeats=1)
 
     chosen = ", ".join(f"{k}={v}" for k, v in sorted(search.best_params_.items()))
+    encoder_chosen = ", ".join(
+        f"{k.split('__')[1]}={v}" for k, v in sorted(encoder_search.best_params_.items())
+    )
+    params = {
+        "MotionTreeHMM (CV-chosen)": chosen,
+        "MotionTreeEncoder + LogisticRegression (CV-chosen)": encoder_chosen,
+    }
+    hmm_proba = lambda X: softmax_scores(hmm.scores(X))  # noqa: E731
     results = [
-        (f"MotionTreeHMM{label}", chosen if not label else "as above", model, seconds)
-        for (label, model), seconds in zip(variants, tree_s)
+        (
+            label,
+            params.get(label, "defaults" if "defaults" in label else "as above"),
+            m,
+            s,
+            m.predict_proba,
+        )
+        for (label, m), s in zip(models, model_s)
     ]
     results += [
-        ("hmmlearn GaussianHMM per class", f"n_states={n_states}, diag", hmm, hmm_s),
-        ("1-NN DTW (tslearn)", "", dtw, dtw_s),
-        ("1-NN Euclidean (resampled)", f"n_frames={length}", euclid, euclid_s),
+        ("hmmlearn GaussianHMM per class", f"n_states={n_states}, diag", hmm, hmm_s, hmm_proba),
+        (
+            "aeon MiniRocketClassifier",
+            "10,000 kernels, ridge alpha by LOO",
+            rocket,
+            rocket_s,
+            rocket.predict_proba,
+        ),
+        ("1-NN DTW (tslearn)", "", dtw, dtw_s, None),
+        ("1-NN Euclidean (resampled)", f"n_frames={length}", euclid, euclid_s, None),
     ]
-    rows = [
-        {
-            "dataset": name,
-            "method": method,
-            "chosen by CV on train": params,
-            "test accuracy": float(np.mean(model.predict(Xte) == yte)),
-            "predict s": seconds,
-            "clips/s": len(Xte) / seconds,
-            "throughput vs hmmlearn": hmm_s / seconds,
-        }
-        for method, params, model, seconds in results
-    ]
+    rows = []
+    for method, chosen_params, model, seconds, proba in results:
+        loss, ece = probability_scores(yte, proba(Xte), model.classes_) if proba else ("", "")
+        rows.append(
+            {
+                "dataset": name,
+                "method": method,
+                "chosen by CV on train": chosen_params,
+                "test accuracy": float(np.mean(model.predict(Xte) == yte)),
+                "log loss": loss,
+                "ECE": ece,
+                "predict ms per clip": 1e3 * seconds / len(Xte),
+                "predict time / MiniRocket's": seconds / rocket_s,
+                "throughput vs hmmlearn": hmm_s / seconds,
+            }
+        )
     return rows, tree
+
+
+def encoder_speed(quick):
+    """Transform time of the default encoder on 40-frame clips of 120 channels."""
+    data = make_motions(n_clips_per_class=4 if quick else 12, random_state=0)
+    from skmotion.io import as_motions
+    from skmotion.preprocessing import VirtualMarkerTransform
+
+    motions = as_motions(data.clips, data.skeletons, data.frame_rate)
+    markers = [m[:, :120] for m in VirtualMarkerTransform().fit_transform(motions)]  # 20 markers
+    windows = [m[s : s + 40] for m in markers for s in range(0, len(m) - 39, 20)]
+    encoder = MotionTreeEncoder().fit(windows)
+    rows = []
+    for n_clips in (1, 100, len(windows)):
+        batch = windows[:n_clips]
+        frames = np.vstack(batch)
+        # A yardstick timed alongside: one multiply over the same frames (the machine is shared).
+        seconds, one_pass = interleaved(
+            [lambda b=batch: encoder.transform(b), lambda f=frames: f * 2.0], REPEATS
+        )
+        rows.append(
+            {
+                "clips per call": n_clips,
+                "frames x channels": "40 x 120",
+                "tree layers": encoder.tree_.n_layers,
+                "output columns": encoder.n_features_out_,
+                "µs per clip": 1e6 * seconds / n_clips,
+                "one pass over the frames, µs per clip": 1e6 * one_pass / n_clips,
+                "transform / one pass": seconds / one_pass,
+                "target µs": 100,
+            }
+        )
+    return rows
 
 
 # -- several scored layers ----------------------------------------------------------------
 
 
 def score_layers_study(name, loader, quick):
-    """Test and CV accuracy against the tree's depth, scored at its bottom layer, three layers, or all."""
+    """Test and CV accuracy against depth, scored at the bottom layer, three layers or all."""
     Xtr, ytr, Xte, yte, groups = loader()
     splits = list(cv_for(ytr, groups).split(Xtr, ytr, groups))
     rows = []
@@ -323,7 +437,7 @@ def score_layers_study(name, loader, quick):
 
 
 def selection_study(name, loader, seeds=range(5)):
-    """The CV-chosen model's test accuracy over shuffles of the folds: repeated and single 5-fold splits."""
+    """The CV-chosen model's test accuracy over shuffles of the folds (repeated, single 5-fold)."""
     Xtr, ytr, Xte, yte, _ = loader()
     rows = []
     for repeats in (3, 1):
@@ -384,7 +498,9 @@ def scaling(quick):
             start = time.perf_counter()
             tree = MotionTree.build(X, min_samples_leaf=16, **kwargs)
             seconds = time.perf_counter() - start
-            memory = peak_memory(lambda: MotionTree.build(X, min_samples_leaf=16, **kwargs))
+            memory = peak_memory(
+                lambda X=X, kwargs=kwargs: MotionTree.build(X, min_samples_leaf=16, **kwargs)
+            )
             leaves = int(tree.n_nodes[-1])
             bkm = ""
             if n <= max_bkm:
@@ -414,7 +530,7 @@ def scaling(quick):
 
 
 def cmu_layer_datasets():
-    """name -> (clips, labels, clip to decode): CMU subjects 01, 02, 03 and all three, 30 Hz virtual markers."""
+    """name -> (clips, labels, clip to decode): CMU subjects 01, 02, 03 and all three (30 Hz)."""
     clips, data = cmu_markers([1, 2, 3])
     if clips is None:
         print(f"CMU: not found in {SHARED_DATA}, its Table I rows are left out")
@@ -445,7 +561,11 @@ def layer_table(datasets, quick):
         if quick:
             layers = [layer for layer in layers if layer <= 8]
         decode_ms = [
-            1e3 * time_call(lambda layer=layer: model.decode([clip], layer=layer), repeats=3)[0]
+            1e3
+            * time_call(
+                lambda layer=layer, model=model, clip=clip: model.decode([clip], layer=layer),
+                repeats=3,
+            )[0]
             for layer in layers
         ]
         rows.append(
@@ -466,39 +586,64 @@ def layer_table(datasets, quick):
 
 
 RECOGNITION_NOTES = (
-    "Hyperparameters of every model chosen by CV on the training set only (stratified 5-fold repeated three "
-    "times, the same splits for every model; subject-wise 3-fold for the synthetic data): MotionTreeHMM by "
-    "GridSearchCV over n_paths, score_layers, split, max_depth, min_samples_leaf, covariance_type and smoothing "
-    "(on CMU: n_paths, score_layers, split, max_depth, covariance_type); hmmlearn's state count. Predict time: "
-    "median over runs of the whole test set, every class scored, MotionTreeHMM's models and hmmlearn timed in "
-    "alternation; 'throughput vs hmmlearn' is hmmlearn's time over the method's. CMU subject 02: "
-    "virtual markers (32 markers, positions and velocities, 192 channels) at 30 Hz, 1 s windows with a 0.5 s hop; "
-    "each trial cut at 60% of its frames, training windows before the cut and test windows after it (split by "
-    "time inside each trial: no window overlaps across train and test); 6 classes (walk, jump, punch, bend, "
-    "swordplay, wash; run/jog's only trial, 1.4 s, is too short for both sides). Its CV folds (stratified 5-fold "
-    "on the training windows, repeated) share overlapping windows, which can only flatter the CV scores used to choose, "
-    "never the test accuracy."
+    "Hyperparameters of every model chosen by CV on the training set only (stratified 5-fold, "
+    "repeated three times unless --quick, the same splits for every model; subject-wise 3-fold "
+    "for the synthetic data): MotionTreeHMM by GridSearchCV over n_paths, score_layers, split, "
+    "max_depth, min_samples_leaf, covariance_type and smoothing (on CMU a smaller grid; --quick: "
+    "split, max_depth, covariance_type); the encoder pipeline over layers, residual_layers and "
+    "LogisticRegression's C (--quick: residual_layers and C); hmmlearn's state count; "
+    "MiniRocket: default kernels, its ridge's alpha by leave-one-out on the training set. "
+    "Probabilities: MotionTreeHMM's predict_proba (temperature fitted by internal CV), the "
+    "encoder's LogisticRegression, hmmlearn's softmax of per-class log-likelihoods, MiniRocket's "
+    "predict_proba (one-hot: its ridge classifier gives no probabilities); log loss with "
+    "probabilities clipped at 1e-15, ECE over 10 bins of the top probability. Predict time: "
+    "median over runs of the whole test set, every model timed in alternation (the machine is "
+    "shared: ratios count, not times). CMU subject 02: virtual markers (32 markers, positions "
+    "and velocities, 192 channels) at 30 Hz, 1 s windows with a 0.5 s hop; each trial cut at 60% "
+    "of its frames, training windows before the cut and test windows after it; 6 classes (walk, "
+    "jump, punch, bend, swordplay, wash). Its CV folds share overlapping windows, which can only "
+    "flatter the CV scores used to choose, never the test accuracy."
+)
+DEFAULTS_NOTES = (
+    "Candidate defaults of MotionTreeHMM (calibration_cv=None: labels do not depend on it) and of "
+    "MotionTreeEncoder (into LogisticRegression(C=1)): accuracy by cross-validation on the "
+    "training set "
+    "(the recognition table's folds; not in the quick run) and on the test set."
+)
+ENCODER_SPEED_NOTES = (
+    "MotionTreeEncoder() fit on 40-frame windows (hop 20) of the synthetic motions' first 20 "
+    "virtual "
+    "markers (120 channels); median time of transform over calls of 1, 100 and all windows, timed "
+    "in alternation with one multiply over the same frames (a yardstick of the machine's load)."
 )
 SCORE_LAYERS_NOTES = (
-    "MotionTreeHMM with two-means splits, min_samples_leaf=4, n_paths=3, smoothing=1, scored at its bottom layer "
-    "alone (score_layers=1, the paper's), at the three bottom layers, or at all layers; CV accuracy on the "
+    "MotionTreeHMM with two-means splits, min_samples_leaf=4, n_paths=3, smoothing=1, scored at "
+    "its bottom layer "
+    "alone (score_layers=1, the paper's), at the three bottom layers, or at all layers; CV "
+    "accuracy on the "
     "training set (the folds of the recognition table) and accuracy on the test set."
 )
 SELECTION_NOTES = (
-    "MotionTreeHMM's grid of the recognition table searched with the folds of five seeds, repeated three times "
+    "MotionTreeHMM's grid of the recognition table searched with the folds of five seeds, repeated"
+    " three times "
     "(as in the recognition table, seed 0) and single; the chosen model's accuracy on the test set."
 )
 SCALING_NOTES = (
-    "Synthetic joint angles (60 channels, 120 Hz), standardised; min_samples_leaf=16, diagonal covariances. "
+    "Synthetic joint angles (60 channels, 120 Hz), standardised; min_samples_leaf=16, diagonal "
+    "covariances. "
     "Growth exponent: slope of log(build s) on log(frames), on the config's last row. Peak memory: "
-    "tracemalloc's peak during a build (the frames themselves not counted). BisectingKMeans (sklearn, "
+    "tracemalloc's peak during a build (the frames themselves not counted). BisectingKMeans "
+    "(sklearn, "
     "random_state=0) gets the tree's leaf count; it is left out where it would take many minutes."
 )
 LAYER_NOTES = (
     "The paper's Table I on the training sets (standardised, min_samples_leaf=16, no depth limit, "
-    "minimum-error splits) and the time of one decode of the first test clip at layers 0, 1, 2, 4, ... and "
-    "the bottom (global graph, n_paths=3). CMU rows: all trials of the subject(s) as 30 Hz virtual markers "
-    "(192 channels), labelled by description; the decoded clip is the first 10 s of the longest trial."
+    "minimum-error splits) and the time of one decode of the first test clip at layers 0, 1, 2, 4,"
+    " ... and "
+    "the bottom (global graph, n_paths=3). CMU rows: all trials of the subject(s) as 30 Hz virtual"
+    " markers "
+    "(192 channels), labelled by description; the decoded clip is the first 10 s of the longest "
+    "trial."
 )
 
 
@@ -507,11 +652,27 @@ def main():
     parser.add_argument("--quick", action="store_true", help="small grids and sizes (a smoke run)")
     parser.add_argument(
         "--only",
-        choices=["recognition", "score_layers", "scaling", "layers", "selection"],
+        choices=[
+            "recognition",
+            "defaults",
+            "encoder_speed",
+            "score_layers",
+            "scaling",
+            "layers",
+            "selection",
+        ],
         help="run one table only (selection, about 25 minutes, runs only when asked)",
     )
+    parser.add_argument(
+        "--data",
+        action="append",
+        help="only the data sets whose name contains this (repeatable); results get a suffix",
+    )
     args = parser.parse_args()
-    loaders = {"synthetic (subject 3 held out)": synthetic}
+    loaders = {
+        "synthetic (subject 3 held out)": synthetic,
+        "synthetic marker positions (subject 3 held out)": synthetic_positions,
+    }
     if (SHARED_DATA / "uea").is_dir():
         loaders = {
             "BasicMotions": lambda: uea("BasicMotions"),
@@ -524,13 +685,25 @@ def main():
         loaders["CMU subject 02, 1 s windows (split by time)"] = cmu_windows
     else:
         print(f"CMU: not found in {SHARED_DATA}, its rows are left out")
+    suffix = ""
+    if args.data:
+        loaders = {k: v for k, v in loaders.items() if any(d in k for d in args.data)}
+        suffix = "_" + "_".join(d.replace(" ", "-") for d in args.data)
     if args.only in (None, "recognition"):
-        rows = [
-            row
-            for name, loader in loaders.items()
-            for row in recognition(name, loader, args.quick)[0]
-        ]
-        write_results("tree_recognition", rows, notes=RECOGNITION_NOTES)
+        rows = []
+        # written after each data set: a long run keeps its rows
+        for name, loader in loaders.items():
+            rows += recognition(name, loader, args.quick)[0]
+            write_results("tree_recognition" + suffix, rows, notes=RECOGNITION_NOTES)
+    if args.only in (None, "defaults"):
+        rows = []
+        for name, loader in loaders.items():
+            data = loader()
+            splits = list(cv_for(data[1], data[4], args.quick).split(data[0], data[1], data[4]))
+            rows += defaults_study(name, data, splits, args.quick)
+        write_results("tree_defaults", rows, notes=DEFAULTS_NOTES)
+    if args.only in (None, "encoder_speed"):
+        write_results("tree_encoder_speed", encoder_speed(args.quick), notes=ENCODER_SPEED_NOTES)
     if args.only in (None, "score_layers"):
         studied = {
             name: loader

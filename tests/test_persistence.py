@@ -23,7 +23,7 @@ from skmotion.preprocessing import (
     ResampleClips,
     VirtualMarkerTransform,
 )
-from skmotion.tree import MotionTreeHMM
+from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
 from tests.preprocessing.test_fill_gaps import _holed_case as _holed_positions
@@ -69,8 +69,10 @@ CASES = {
         {
             "decode": _extra("decode"),
             "predict_next": lambda est, X: [est.predict_next(X, 2).probabilities],
+            "novelty_score": _extra("novelty_score"),
         },
     ),
+    "MotionTreeEncoder": (MotionTreeEncoder(max_depth=3, layers="all"), _motions, {}),
     "IntervalIndexNeighbors": (
         IntervalIndexNeighbors(n_levels=3, n_neighbors=2),
         _motions,
@@ -204,7 +206,10 @@ def test_tampered_version_is_refused(name, tmp_path):
     newer = f"{major}.{minor + 1}.0".encode()
     # Same length keeps the pickle valid, so only the recorded version changes.
     tampered = data.replace(version, newer.ljust(len(version), b"0")[: len(version)])
-    message = rf"saved by skmotion {major}\.{minor + 1}\.0 and cannot be loaded by skmotion {skmotion.__version__}"
+    message = (
+        rf"saved by skmotion {major}\.{minor + 1}\.0 and cannot be loaded by skmotion "
+        rf"{skmotion.__version__}"
+    )
     with pytest.raises(IncompatibleVersionError, match=message):
         pickle.loads(tampered)
     path = tmp_path / "model.joblib"

@@ -4,12 +4,19 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.model_selection import StratifiedKFold
 from sklearn.utils import Bunch
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, column_or_1d
 
 from skmotion.base import ClipEstimatorMixin
 from skmotion.tree._batch import decode_clips
+from skmotion.tree._calibration import (
+    fit_temperature,
+    log_softmax_rows,
+    mixture_log_density,
+    per_frame,
+)
 from skmotion.tree._decode import NODE_PRIORS
 from skmotion.tree._gaussian import COVARIANCE_TYPES
 from skmotion.tree._motion_tree import MotionTree
@@ -17,23 +24,11 @@ from skmotion.tree._split import SPLIT_CRITERIA
 from skmotion.tree._transitions import TransitionGraphs
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._labels import check_label_types
+from skmotion.utils._progress import progress, say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 from skmotion.utils._validation import check_int
 
 __all__ = ["MotionTreeHMM"]
-
-
-def _logsumexp(a, axis, keepdims=False):
-    """``log sum exp`` along an axis; ``-inf`` where every term is.
-
-    scipy's ``logsumexp`` spends about 0.1 ms per call on array-API dispatch,
-    a tenth of a whole ``predict`` on small collections.
-    """
-    top = np.max(a, axis=axis, keepdims=True)
-    top[~np.isfinite(top)] = 0.0
-    with np.errstate(divide="ignore"):
-        out = np.log(np.sum(np.exp(a - top), axis=axis, keepdims=True)) + top
-    return out if keepdims else np.squeeze(out, axis=axis)
 
 
 def _sum_of_paths(scores):
@@ -51,6 +46,8 @@ def _sum_of_paths(scores):
 
 _check_count = check_int  # the one integer check, skmotion.utils._validation
 
+_NOVELTY_CHUNK = 4096  # frames per block of node densities in novelty_score
+
 
 class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     """Recognise motion clips with a binary tree of frame clusters and node transition graphs.
@@ -65,18 +62,22 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     Parameters
     ----------
-    max_depth : int, default=10
+    max_depth : int, default=8
         The deepest layer of the tree (the root is layer 0); None for no limit
-        (the paper's choice). Decoding costs one pass per layer, and
-        minimum-error splits can grow very deep trees, hence the default.
+        (the paper's choice). Decoding costs one pass per layer.
     min_samples_split : int, default=2
         A node with fewer frames is not split.
-    min_samples_leaf : int, default=16
-        A split is only made when both sides keep this many frames.
-    split : {"min_error", "two_means", "median"}, default="min_error"
-        How a node's projections on its first principal axis are cut:
-        Kittler-Illingworth minimum-error thresholding (the paper's), 1-D
-        2-means, or the median (balanced trees).
+    min_samples_leaf : int, default=4
+        A split is only made when both sides keep this many frames (the
+        paper's databases use 16).
+    split : {"two_means", "median", "min_error"}, default="two_means"
+        How a node's projections on its first principal axis are cut: 1-D
+        2-means, the median (balanced trees), or Kittler-Illingworth
+        minimum-error thresholding (the paper's, which cuts off small tails
+        and grows deep, unbalanced trees). The defaults of ``split``,
+        ``max_depth``, ``min_samples_leaf`` and ``score_layers`` were the most
+        accurate candidates on every development data set (the user guide's
+        table); :data:`PAPER_SETTINGS` gives the paper's.
     covariance_type : {"diag", "full", "spherical"}, default="diag"
         The covariance estimator of each node; ``"full"`` is Ledoit-Wolf shrunk.
     reg_covar : float, default=1e-6
@@ -105,7 +106,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     layer : int, default=None
         The layer to classify at (negative counts from the bottom); None for
         the bottom layer. Upper layers are faster and coarser.
-    score_layers : int or "all", default=1
+    score_layers : int or "all", default="all"
         How many layers, ending at ``layer``, classify together: a clip's score
         under a graph is the product of its generation probabilities at each
         of them (a product of experts over the tree's resolutions; the paper
@@ -121,6 +122,16 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         the tree, whose principal axes otherwise follow the channels with the
         largest units. Node means reported by ``predict_next`` are in the
         input's units either way.
+    calibration_cv : int or None, default=3
+        Folds of the internal cross-validation that fits the temperature of
+        ``predict_proba`` (stratified, shuffled with a fixed seed; at most the
+        smallest class's clip count). The tree is built once on all frames
+        (it sees no labels); each fold recounts the graphs without its
+        held-out clips and scores them. None, or a smallest class of one
+        clip, keeps ``temperature_ = 1``. Labels (``predict``) never depend on it.
+    verbose : int, default=0
+        0 is silent; 1 or more reports the stages of ``fit`` (tree, graphs,
+        calibration folds) on standard error.
     n_jobs : int, default=None
         Jobs over groups of clips (and their graphs) when decoding; None means
         1 unless in a ``joblib.parallel_config`` context. Results do not
@@ -150,6 +161,12 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         Number of layers of the tree.
     n_nodes_ : ndarray of shape (n_layers_,)
         Number of nodes in each layer.
+    temperature_ : float
+        Divides the per-frame log generation probabilities before the softmax
+        of ``predict_proba`` (fitted by log loss on held-out folds).
+    log_node_weights_ : ndarray of shape (n_nodes_[layer_],)
+        Log share of the training frames in each node of ``layer_``: the
+        mixing weights of ``novelty_score``'s density.
     n_features_in_ : int
         Number of channels.
     feature_names_in_ : ndarray of str
@@ -158,6 +175,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     See Also
     --------
     MotionTree : the tree data structure.
+    MotionTreeEncoder : the same tree as a vocabulary of poses, features for a linear model.
     TransitionGraphs : the node transition graphs.
 
     Notes
@@ -207,16 +225,18 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         "layer": [Interval(Integral, None, None, closed="neither"), None],
         "score_layers": [Interval(Integral, 1, None, closed="left"), StrOptions({"all"})],
         "standardize": ["boolean"],
+        "calibration_cv": [Interval(Integral, 2, None, closed="left"), None],
+        "verbose": ["verbose"],
         "n_jobs": [Integral, None],
     }
 
     def __init__(
         self,
         *,
-        max_depth=10,
+        max_depth=8,
         min_samples_split=2,
-        min_samples_leaf=16,
-        split="min_error",
+        min_samples_leaf=4,
+        split="two_means",
         covariance_type="diag",
         reg_covar=1e-6,
         graph="class",
@@ -224,8 +244,10 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         smoothing=1.0,
         n_paths=3,
         layer=None,
-        score_layers=1,
+        score_layers="all",
         standardize=True,
+        calibration_cv=3,
+        verbose=0,
         n_jobs=None,
     ):
         self.max_depth = max_depth
@@ -241,6 +263,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.layer = layer
         self.score_layers = score_layers
         self.standardize = standardize
+        self.calibration_cv = calibration_cv
+        self.verbose = verbose
         self.n_jobs = n_jobs
 
     @_fit_context(prefer_skip_nested_validation=True)
@@ -275,6 +299,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             spread = frames.std(axis=0)
             self.scale_ = np.where(spread > 0, spread, 1.0)
             frames = (frames - self.center_) / self.scale_
+        say(self.verbose, f"MotionTreeHMM: building the tree over {len(frames):,} frames")
         tree = MotionTree.build(
             frames,
             max_depth=self.max_depth,
@@ -293,9 +318,24 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             if self.layer_
             else np.zeros(1, int)
         )
+        say(self.verbose, f"MotionTreeHMM: {tree.n_layers} layers; counting the transition graphs")
         labels = list(tree.iter_apply(frames))
-        n_clips = len(clips)
-        self.global_graph_ = TransitionGraphs.count(
+        self.global_graph_, self.graphs_, self.graph_classes_ = self._count_graphs(
+            tree, labels, offsets, y_index
+        )
+        self.tree_ = tree
+        self.n_layers_ = tree.n_layers
+        self.n_nodes_ = tree.n_nodes
+        visits = self.global_graph_.visits(self.layer_)[0]
+        with np.errstate(divide="ignore"):
+            self.log_node_weights_ = np.log(visits / visits.sum())
+        self.temperature_ = self._fit_temperature(clips, labels, offsets, y_index)
+        return self
+
+    def _count_graphs(self, tree, labels, offsets, y_index):
+        """The global graph, the classifying graphs and the class of each, from routed frames."""
+        n_clips = len(offsets) - 1
+        global_graph = TransitionGraphs.count(
             labels,
             tree.n_nodes,
             offsets=offsets,
@@ -304,39 +344,76 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             smoothing=self.smoothing,
         )
         if self.graph == "class":
-            graph_of_clip, self.graph_classes_ = y_index, np.arange(len(self.classes_))
+            graph_of_clip, graph_classes = y_index, np.arange(len(self.classes_))
         else:
-            graph_of_clip, self.graph_classes_ = np.arange(n_clips), y_index
-        self.graphs_ = TransitionGraphs.count(
+            graph_of_clip, graph_classes = np.arange(n_clips), y_index
+        graphs = TransitionGraphs.count(
             labels,
             tree.n_nodes,
             offsets=offsets,
             graph_of_clip=graph_of_clip,
-            n_graphs=len(self.graph_classes_),
+            n_graphs=len(graph_classes),
             smoothing=self.smoothing,
         )
-        self.tree_ = tree
-        self.n_layers_ = tree.n_layers
-        self.n_nodes_ = tree.n_nodes
-        return self
+        return global_graph, graphs, graph_classes
+
+    def _fit_temperature(self, clips, labels, offsets, y_index):
+        """The softmax temperature of ``predict_proba``, by internal cross-validation.
+
+        The tree is shared (it is built without labels); each fold recounts the
+        graphs from its training clips only and scores its held-out clips.
+        """
+        n_folds = min(self.calibration_cv or 0, np.bincount(y_index).min())
+        if n_folds < 2 or len(self.classes_) < 2:
+            return 1.0
+        lengths = np.diff(offsets)
+        folds = StratifiedKFold(n_folds, shuffle=True, random_state=0).split(lengths, y_index)
+        scores, truth = [], []
+        for train, held_out in progress(
+            list(folds), verbose=self.verbose, desc="MotionTreeHMM: calibration folds"
+        ):
+            keep = np.repeat(np.isin(np.arange(len(lengths)), train), lengths)
+            sub_offsets = np.r_[0, np.cumsum(lengths[train])]
+            guide, graphs, graph_classes = self._count_graphs(
+                self.tree_, [lab[keep] for lab in labels], sub_offsets, y_index[train]
+            )
+            held = [clips[i] for i in held_out]
+            log_prob = self._class_log_probs(
+                held, exact=False, graphs=graphs, graph_classes=graph_classes, guide=guide
+            )
+            scores.append(per_frame(log_prob, lengths[held_out]))
+            truth.append(y_index[held_out])
+        return fit_temperature(np.vstack(scores), np.concatenate(truth))
 
     # -- decoding ------------------------------------------------------------------
 
     def _decode(
-        self, clips, graphs, layer, n_graphs, *, score_layers=1, exact=True, prune=False, paths=True
+        self,
+        clips,
+        graphs,
+        layer,
+        n_graphs,
+        *,
+        score_layers=1,
+        exact=True,
+        prune=False,
+        paths=True,
+        guide=None,
     ):
-        """Beam-decode every clip under every graph: paths and scores per clip (see ``decode_clips``).
+        """Beam-decode every clip under every graph: paths and scores per clip (``decode_clips``).
 
         Without ``exact``, and when the normaliser of ``Ps`` is the same for
         every graph (``node_prior="layer"``), scores skip it: rankings are equal.
         With ``prune``, graphs that cannot score a clip best get ``-inf`` (for ``predict``).
+        ``guide`` replaces the global graph in the shared search (calibration folds).
         """
         normalise = exact or self.node_prior != "layer"
         # One beam search per clip on the global graph, shared by all graphs. Under
         # node_prior="graph" a graph may have no candidate left in the shared beam,
         # so each graph then searches on its own (and nothing is pruned: pruning
         # compares the graphs of a clip within its shared search).
-        guide = self.global_graph_ if self.node_prior == "layer" else None
+        guide = self.global_graph_ if guide is None else guide
+        guide = guide if self.node_prior == "layer" else None
         frames, offsets = stack_clips(clips)
         return decode_clips(
             self.tree_,
@@ -355,28 +432,34 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             n_jobs=self.n_jobs,
         )
 
-    def _class_log_probs(self, clips, exact=True, prune=False):
+    def _class_log_probs(
+        self, clips, exact=True, prune=False, graphs=None, graph_classes=None, guide=None
+    ):
         """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
 
         The product over the scored layers. Without ``exact``, up to a constant
         per clip (enough to rank classes). With ``prune``, ``-inf`` for classes
-        that provably do not score best.
+        that provably do not score best. ``graphs``, ``graph_classes`` and
+        ``guide`` replace the fitted ones (calibration folds).
         """
+        if graphs is None:
+            graphs, graph_classes = self.graphs_, self.graph_classes_
         _, scores = self._decode(
             clips,
-            self.graphs_,
+            graphs,
             self.layer_,
-            len(self.graph_classes_),
+            len(graph_classes),
             score_layers=len(self.score_layers_),
             exact=exact,
             prune=prune,
             paths=False,
+            guide=guide,
         )
         per_graph = _sum_of_paths(scores).sum(axis=2)
         if self.graph == "class":
             return per_graph
         out = np.full((len(clips), len(self.classes_)), -np.inf)
-        np.maximum.at(out.T, self.graph_classes_, per_graph.T)
+        np.maximum.at(out.T, graph_classes, per_graph.T)
         return out
 
     def score_samples(self, X):
@@ -398,8 +481,60 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         check_is_fitted(self)
         return self._class_log_probs(check_clips(X, estimator=self))
 
+    def decision_function(self, X):
+        """Per-frame log generation probability of each clip under each class, over the temperature.
+
+        ``log P(clip | class) / (n_frames * temperature_)``, up to a constant per
+        clip: the softmax of a row is ``predict_proba``; its argmax is
+        ``predict`` (which prunes, with the same labels).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        scores : ndarray of shape (n_clips, n_classes) or (n_clips,)
+            Columns follow ``classes_``; with two classes, as sklearn expects,
+            one column: the second class's score minus the first's.
+        """
+        scores = self._scores(X)
+        if len(self.classes_) == 2:
+            with np.errstate(invalid="ignore"):
+                return scores[:, 1] - scores[:, 0]
+        return scores
+
+    def _scores(self, X):
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        log_prob = self._class_log_probs(clips, exact=False)
+        return per_frame(log_prob, [len(c) for c in clips]) / self.temperature_
+
+    def predict_log_proba(self, X):
+        """Log class probabilities: a softmax of ``decision_function`` (see ``predict_proba``).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        log_proba : ndarray of shape (n_clips, n_classes)
+        """
+        return log_softmax_rows(self._scores(X))
+
     def predict_proba(self, X):
-        """Generation probabilities normalised over the classes.
+        """Class probabilities from per-frame generation probabilities and a fitted temperature.
+
+        ``softmax(log P(clip | class) / (n_frames * temperature_))``: dividing by
+        the clip's length keeps a long clip from making every answer certain
+        (the plain normalised generation probabilities are near 0 or 1 for
+        nearly every clip, the wrong ones included); ``temperature_`` is fitted
+        by log loss on held-out folds in ``fit`` (``calibration_cv``). Rows are
+        finite and sum to 1 for any finite input: a clip that no class can
+        generate (scores ``-inf`` or NaN, e.g. frames far beyond the data's
+        range) gets equal probabilities. ``novelty_score`` says how unlike the
+        training data a clip is, which these probabilities do not.
 
         Parameters
         ----------
@@ -409,9 +544,44 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         -------
         proba : ndarray of shape (n_clips, n_classes)
         """
+        return np.exp(self.predict_log_proba(X))
+
+    def novelty_score(self, X):
+        """Mean log density of each clip's frames under the tree's nodes: lower is more novel.
+
+        The nodes of ``layer_`` as a Gaussian mixture, each weighted by its share
+        of the training frames, in standardised units (``center_``,
+        ``scale_``): ``mean_i log sum_k w_k N(x_i | k)``. Unlike the generation
+        probabilities, whose ``Ps(k | x)`` is normalised per frame (so a frame far
+        from every node still picks one with certainty), this density falls as
+        a clip moves away from the training frames. Threshold it, e.g., at a low
+        quantile of the training clips' scores to flag clips to reject.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        score : ndarray of shape (n_clips,)
+            Higher for clips like the training data (sklearn's ``score_samples``
+            convention for novelty); ``-inf`` when a frame is so far that its
+            density underflows.
+        """
         check_is_fitted(self)
-        log_prob = self._class_log_probs(check_clips(X, estimator=self), exact=False)
-        return np.exp(log_prob - _logsumexp(log_prob, axis=1, keepdims=True))
+        clips = check_clips(X, estimator=self)
+        frames, offsets = stack_clips(clips)
+        frames = (frames - self.center_) / self.scale_
+        density = np.empty(len(frames))
+        for start in range(0, len(frames), _NOVELTY_CHUNK):  # bounded memory: chunk x nodes
+            chunk = frames[start : start + _NOVELTY_CHUNK]
+            with np.errstate(over="ignore", invalid="ignore"):
+                log_pdf = self.tree_.log_likelihood(chunk, self.layer_)
+            log_pdf[np.isnan(log_pdf)] = -np.inf
+            density[start : start + _NOVELTY_CHUNK] = mixture_log_density(
+                log_pdf, self.log_node_weights_
+            )
+        return np.add.reduceat(density, offsets[:-1]) / np.diff(offsets)
 
     def predict(self, X):
         """The class whose graph generates each clip with the highest probability.
@@ -432,6 +602,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     def predict_proba_windows(self, X, width, step=1):
         """Class probabilities of sliding windows: the time profiles of the paper's Figures 10-12.
+
+        Each window's row is ``predict_proba`` of the window as a clip.
 
         Parameters
         ----------
@@ -454,7 +626,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         starts = [np.arange(0, max(len(c) - width, 0) + 1, step) for c in clips]
         windows = [c[s : s + width] for c, st in zip(clips, starts) for s in st]
         log_prob = self._class_log_probs(windows, exact=False)
-        proba = np.exp(log_prob - _logsumexp(log_prob, axis=1, keepdims=True))
+        scores = per_frame(log_prob, [len(w) for w in windows]) / self.temperature_
+        proba = np.exp(log_softmax_rows(scores))
         return np.split(proba, np.cumsum([len(s) for s in starts])[:-1])
 
     def _resolve_layer(self, layer):
@@ -516,7 +689,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         k = self.tree_.n_nodes[layer]
         paths, scores = self._decode(clips, self.global_graph_, layer, 1, exact=False)
         scores = scores[:, 0, -1]  # the one graph, at the one layer
-        weights = np.exp(scores - _logsumexp(scores, axis=1, keepdims=True))
+        weights = np.exp(log_softmax_rows(scores))
         current = np.zeros((len(clips), k))
         for i, p in enumerate(paths):
             valid = p[0, :, -1] >= 0

@@ -69,7 +69,9 @@ def test_string_labels_and_probabilities(motions):
     log_prob = model.score_samples(X[:6])
     proba = model.predict_proba(X[:6])
     np.testing.assert_allclose(proba.sum(axis=1), 1.0)
-    np.testing.assert_allclose(proba, np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True)))
+    # per-frame generation probabilities over the fitted temperature, then a softmax
+    scaled = log_prob / np.array([len(c) for c in X[:6]])[:, None] / model.temperature_
+    np.testing.assert_allclose(proba, np.exp(scaled - logsumexp(scaled, axis=1, keepdims=True)))
     np.testing.assert_array_equal(model.predict(X[:6]), model.classes_[log_prob.argmax(axis=1)])
 
 
@@ -77,7 +79,9 @@ def test_string_labels_and_probabilities(motions):
 def test_generation_probabilities_match_the_exhaustive_reference(motions, graph):
     X, y, _ = motions
     X, y = X[::4], y[::4]
-    model = MotionTreeHMM(max_depth=3, min_samples_leaf=30, n_paths=8, graph=graph).fit(X, y)
+    model = MotionTreeHMM(
+        max_depth=3, min_samples_leaf=30, n_paths=8, graph=graph, score_layers=1
+    ).fit(X, y)
     assert model.n_nodes_.max() <= 8  # n_paths covers every node: the beam prunes nothing
     query = [(X[0][::3] - model.center_) / model.scale_, (X[5][:7] - model.center_) / model.scale_]
     per_graph = np.array(
@@ -275,14 +279,15 @@ def test_several_scored_layers_multiply_their_generation_probabilities(motions):
     model = MotionTreeHMM(max_depth=5, split="median", score_layers=3).fit(X[::2], y[::2])
     np.testing.assert_array_equal(model.score_layers_, [3, 4, 5])
     per_layer = [
-        MotionTreeHMM(max_depth=5, split="median", layer=layer).fit(X[::2], y[::2])
+        MotionTreeHMM(max_depth=5, split="median", layer=layer, score_layers=1).fit(X[::2], y[::2])
         for layer in (3, 4, 5)
     ]
     expected = np.sum([m.score_samples(X[1::3]) for m in per_layer], axis=0)
     np.testing.assert_allclose(model.score_samples(X[1::3]), expected, rtol=1e-10)
     log_prob = model.score_samples(X[:5])
+    scaled = log_prob / np.array([len(c) for c in X[:5]])[:, None] / model.temperature_
     np.testing.assert_allclose(
-        model.predict_proba(X[:5]), np.exp(log_prob - logsumexp(log_prob, axis=1, keepdims=True))
+        model.predict_proba(X[:5]), np.exp(scaled - logsumexp(scaled, axis=1, keepdims=True))
     )
 
 

@@ -1,0 +1,141 @@
+"""Clip histograms over a motion tree's nodes: occupancy per temporal-pyramid cell and transitions.
+
+Free functions on routed node labels (see :class:`TreeRouter`), used by
+:class:`MotionTreeEncoder`. All clips are handled together: each frame adds one
+entry per (layer, pyramid level) to a sparse matrix whose duplicates sum into
+the histograms.
+"""
+
+import numpy as np
+import scipy.sparse as sp
+
+__all__ = ["feature_blocks", "histogram_features", "residual_features"]
+
+
+def feature_blocks(layers, n_nodes, pyramid, transition_layers):
+    """The sparse blocks of the feature vector, in order: ``(kind, layer, parts, width)``.
+
+    ``kind`` is ``"occupancy"`` (one block per layer and pyramid level, ``parts``
+    cells of ``n_nodes[layer]`` columns) or ``"transitions"`` (``parts`` is 1,
+    ``n_nodes[layer] ** 2`` columns).
+    """
+    blocks = [
+        ("occupancy", int(layer), int(parts), int(n_nodes[layer]) * int(parts))
+        for layer in layers
+        for parts in pyramid
+    ]
+    blocks += [
+        ("transitions", int(layer), 1, int(n_nodes[layer]) ** 2) for layer in transition_layers
+    ]
+    return blocks
+
+
+def histogram_features(nodes, offsets, layers, blocks, power):
+    """Per-clip normalised histograms of routed frames, as a CSR matrix.
+
+    Parameters
+    ----------
+    nodes : ndarray of shape (n_frames, n_layers_routed)
+        Layer index of every frame's node, for the layers ``layers``.
+    offsets : ndarray of shape (n_clips + 1,)
+        Clip ``i`` is frames ``offsets[i]:offsets[i + 1]``.
+    layers : sequence of int
+        The layer of each column of ``nodes``.
+    blocks : list of tuple
+        From :func:`feature_blocks`.
+    power : float
+        Every entry is raised to this power (0.5: Hellinger's square root).
+
+    Returns
+    -------
+    features : scipy.sparse.csr_matrix of shape (n_clips, n_features)
+        Occupancy cell ``c`` of ``parts`` holds the share of the clip's frames
+        ``[c n / parts, (c + 1) n / parts)`` in each node (each cell sums to 1
+        before ``power``); a transition entry is the share of the clip's
+        ``n - 1`` steps that go from one node to another (staying is not
+        counted: occupancy says it).
+    """
+    n_clips = len(offsets) - 1
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(n_clips), lengths)
+    position = np.arange(offsets[-1]) - offsets[clip]
+    column_of = {layer: j for j, layer in enumerate(layers)}
+    rows, cols, vals = [], [], []
+    start = 0
+    for kind, layer, parts, width in blocks:
+        node = nodes[:, column_of[layer]]
+        k = width // parts if kind == "occupancy" else int(np.sqrt(width))
+        if kind == "occupancy":
+            cell = position * parts // lengths[clip]
+            key = clip * parts + cell
+            size = np.bincount(key, minlength=n_clips * parts)
+            rows.append(clip)
+            cols.append(start + cell * k + node)
+            vals.append(1.0 / size[key])
+        else:
+            same_clip = position[:-1] + 1 < lengths[clip[:-1]]
+            step = np.flatnonzero(same_clip & (node[:-1] != node[1:]))
+            src_clip = clip[step]
+            rows.append(src_clip)
+            cols.append(start + node[step] * k + node[step + 1])
+            vals.append(1.0 / (lengths[src_clip] - 1))
+        start += width
+    if not blocks:
+        return sp.csr_matrix((n_clips, 0))
+    matrix = sp.csr_matrix(
+        (np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+        shape=(n_clips, start),
+    )
+    matrix.sum_duplicates()
+    if power != 1:
+        np.power(matrix.data, power, out=matrix.data)
+    return matrix
+
+
+def residual_features(frames, nodes, offsets, means, center, scale, power):
+    """Per clip and node, the mean offset of the clip's frames from the node's mean (VLAD).
+
+    For each layer, ``sum_{t in node k} (z_t - mean_k) / n_frames`` for every
+    node ``k`` (zeros where the clip has no frame), with ``z = (x - center) /
+    scale``, raised to ``power`` with its sign, and the layer's block scaled to
+    unit Euclidean norm (so every layer weighs alike, whatever its node count).
+    Where occupancy says which poses a clip visits, this says how its frames
+    sit within them: the continuous detail a partition loses.
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, n_channels)
+        Raw frames (the standardisation is applied to the sums).
+    nodes : ndarray of shape (n_frames, n_layers)
+        Layer index of every frame's node in each encoded layer.
+    offsets : ndarray of shape (n_clips + 1,)
+    means : list of ndarray of shape (n_nodes(layer), n_channels)
+        The nodes' mean frames (standardised), per layer.
+    center, scale : ndarray of shape (n_channels,)
+    power : float
+
+    Returns
+    -------
+    features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
+    """
+    n_clips, n_frames = len(offsets) - 1, len(frames)
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(n_clips), lengths)
+    weight = 1.0 / lengths[clip]
+    blocks = []
+    for j, mean in enumerate(means):
+        k = len(mean)
+        group = clip * k + nodes[:, j]
+        # (clip, node) x frame averaging matrix: one sparse product sums every group of raw
+        # frames; sum (x - c) / s - mean = (sum x - share c) / s - share mean, share = sum 1 / n
+        average = sp.csr_matrix(
+            (weight, (group, np.arange(n_frames))), shape=(n_clips * k, n_frames)
+        )
+        share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
+        block = ((average @ frames - share * center) / scale).reshape(n_clips, k, -1)
+        block = (block - share.reshape(n_clips, k, 1) * mean).reshape(n_clips, -1)
+        if power != 1:
+            block = np.sign(block) * np.abs(block) ** power
+        norm = np.linalg.norm(block, axis=1, keepdims=True)
+        blocks.append(block / np.where(norm > 0, norm, 1.0))
+    return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))
