@@ -1,9 +1,13 @@
-"""The compiled part of skmotion: the beam Viterbi's inner loops (everything else is in pyproject.toml)."""
+"""The compiled part of skmotion: the beam Viterbi's inner loops.
+
+Everything else is in pyproject.toml.
+"""
 
 from Cython.Build import cythonize
 from setuptools import Extension, setup
 
-# -fopenmp-simd honours the `omp simd` pragmas of _emission.h (vectorised sums) without linking OpenMP.
+# -fopenmp-simd honours the `omp simd` pragmas of _emission.h (vectorised sums) without
+# linking OpenMP.
 beam = Extension(
     "skmotion.tree._beam",
     ["skmotion/tree/_beam.pyx"],

@@ -108,14 +108,16 @@ def main(n_files=4, repeats=5):
     write_results(
         "io_bvh",
         bvh_rows,
-        notes="MB/s of reading a BVH file to channel values in memory (median of 5 interleaved rounds); speedup = "
-        "time of the fastest of bvh and bvhio / time of skmotion.read_bvh (target >= 5).",
+        notes="MB/s of reading a BVH file to channel values in memory (median of 5 interleaved "
+        "rounds); speedup = time of the fastest of bvh and bvhio / time of skmotion.read_bvh "
+        "(target >= 5).",
     )
     amc_rows = bench_amc(by_size(SHARED_DATA.glob("cmu-asfamc/*/*.amc")), repeats)
     write_results(
         "io_amc",
         amc_rows,
-        notes="MB/s of reading a CMU AMC file (skeleton already read) against a line-by-line Python parser.",
+        notes="MB/s of reading a CMU AMC file (skeleton already read) against a line-by-line "
+        "Python parser.",
     )
 
 

@@ -164,11 +164,11 @@ def main(hmm_sizes, reader_sizes):
     write_results(
         "long_inputs",
         rows,
-        notes="Time and growth of peak resident memory (VmHWM reset before the call, each measurement in a fresh "
-        "process) against "
-        "the input's own size (extra_per_input; input: the clip, or the channel array read from a file of file_MB). time_vs_peer / extra_vs_peer: skmotion over the peer, same "
-        "input. loglik_per_frame: the best class's log-likelihood per frame (the same at every length: no "
-        "underflow).",
+        notes="Time and growth of peak resident memory (VmHWM reset before the call, each "
+        "measurement in a fresh process) against the input's own size (extra_per_input; input: "
+        "the clip, or the channel array read from a file of file_MB). time_vs_peer / "
+        "extra_vs_peer: skmotion over the peer, same input. loglik_per_frame: the best class's "
+        "log-likelihood per frame (the same at every length: no underflow).",
     )
 
 

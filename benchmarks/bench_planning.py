@@ -76,7 +76,10 @@ def _run(name, X, target, transformer, body_size):
                 plain = model.plan(
                     (0, 0, 0), GOAL, heuristic_weight=1.0, max_expansions=20_000, **kwargs
                 )
-                ratio = f"{plain.search_seconds / plan.search_seconds:.3g} (log_p {plain.log_probability:.1f})"
+                ratio = (
+                    f"{plain.search_seconds / plan.search_seconds:.3g} "
+                    f"(log_p {plain.log_probability:.1f})"
+                )
             except UnreachableGoalError:
                 ratio = "plain A* gave up at 20k expansions"
             rows.append(
@@ -120,8 +123,9 @@ def main():
         "planning",
         rows,
         notes=(
-            f"goal {GOAL[0]} m ahead, {GOAL[1]} m left; tolerance 0.15 m; {FRAME_RATE:g} fps; heuristic_weight=8 "
-            "(plain_astar_ratio: search time of heuristic_weight=1 over it, same run)"
+            f"goal {GOAL[0]} m ahead, {GOAL[1]} m left; tolerance 0.15 m; {FRAME_RATE:g} fps; "
+            "heuristic_weight=8 (plain_astar_ratio: search time of heuristic_weight=1 over it, "
+            "same run)"
         ),
     )
 

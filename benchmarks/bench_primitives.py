@@ -137,7 +137,9 @@ def error_tables(clips, frame_rate):
                     "MSE (deg^2 per segment)": controller.clustering_mse_,
                     "RMS train (deg)": float(np.sqrt(total / n_features)),
                     "RMS test (deg)": float(np.sqrt(np.mean(test_rms**2))),
-                    "median RMS train/test (deg)": f"{np.median(train_rms):.2f}/{np.median(test_rms):.2f}",
+                    "median RMS train/test (deg)": (
+                        f"{np.median(train_rms):.2f}/{np.median(test_rms):.2f}"
+                    ),
                 }
             )
     for row in rows:
@@ -233,8 +235,8 @@ def arm_tracking(data, arm, clips):
 
 TABLE_NOTES = (
     "100 samples per channel and segment (400-D vectors); segments with movement above "
-    f"{MIN_MOVEMENT} deg; 75/25 random split of the segments. MSE is per segment vector (sum of the "
-    "400 squared errors); RMS is per sample, sqrt(MSE / 400). Table 1 rows: projection only. "
+    f"{MIN_MOVEMENT} deg; 75/25 random split of the segments. MSE is per segment vector (sum of "
+    "the 400 squared errors); RMS is per sample, sqrt(MSE / 400). Table 1 rows: projection only. "
     "Table 2-3 rows: 30 eigenvectors, segments replaced by their cluster centre; RMS train = "
     "sqrt((projection MSE + clustering MSE) / 400), checked against the measured error; the last "
     "column is the median over segments of their RMS (the paper's 19.4 train / 22.3 test degrees)."
@@ -256,8 +258,8 @@ def main():
                 error_tables(cmu_clips, cmu_data.frame_rate),
                 notes=(
                     f"CMU subjects 01-03: {len(cmu_clips)} trials, "
-                    f"{sum(len(c) for c in cmu_clips):,} frames at {cmu_data.frame_rate:g} Hz; right arm "
-                    "(rhumerus rx ry rz, rradius rx) in degrees. " + TABLE_NOTES
+                    f"{sum(len(c) for c in cmu_clips):,} frames at {cmu_data.frame_rate:g} Hz; "
+                    "right arm (rhumerus rx ry rz, rradius rx) in degrees. " + TABLE_NOTES
                 ),
             )
         write_results(
@@ -275,17 +277,19 @@ def main():
                 "Fit on the right-arm clips: skmotion EigenMovementPCA(30, SEG-2) + "
                 "KMeansPrimitiveController(30) from clips, against sklearn PCA(30) + KMeans(30) on "
                 "the same segment vectors made beforehand (same K-means seed); median of 7 "
-                "interleaved rounds, one thread. The last three columns split it: EigenMovementPCA "
-                "alone, sklearn PCA alone, and the making of the vectors (filter, segment, resample)."
+                "interleaved rounds, one thread. The last three columns split it: "
+                "EigenMovementPCA alone, sklearn PCA alone, and the making of the vectors (filter, "
+                "segment, resample)."
             ),
         )
         write_results(
             "primitives_arm",
             arm_tracking(data, arm, clips),
             notes=(
-                "One clip of each class, rebuilt from its 30 K-means primitives (30 eigenmovements), "
-                "executed on the MuJoCo arm (upper arm 0.29 m, forearm and hand 0.44 m, cylinders "
-                "of density 1050) by PD servos without gravity compensation, 1 ms steps."
+                "One clip of each class, rebuilt from its 30 K-means primitives (30 "
+                "eigenmovements), executed on the MuJoCo arm (upper arm 0.29 m, forearm and hand "
+                "0.44 m, cylinders of density 1050) by PD servos without gravity compensation, "
+                "1 ms steps."
             ),
         )
 

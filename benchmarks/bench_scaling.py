@@ -1,4 +1,5 @@
-"""Scale-out: the wall time of a grid search, serial, on 2 local (loky) workers and on a Dask LocalCluster.
+"""Scale-out: the wall time of a grid search, serial, on 2 local (loky) workers and on a Dask
+LocalCluster.
 
 Two searches, each on its own data, each run in every configuration in one run:
 
@@ -148,11 +149,15 @@ def main(quick=False):
             client.close()
             cluster.close()
     notes = (
-        "GroupKFold grid searches (4 folds; 3 on CMU's 3 subjects); one run per configuration, timed in the same process. "
-        "The machine has 2 cores shared with other work, so 2 workers can at best halve the time."
+        "GroupKFold grid searches (4 folds; 3 on CMU's 3 subjects); one run per configuration, "
+        "timed in the same process. The machine has 2 cores shared with other work, so 2 "
+        "workers can at best halve the time."
     )
     if startup is not None:
-        notes += f" Dask LocalCluster (2 worker processes) start-up, not included above: {startup:.1f} s."
+        notes += (
+            " Dask LocalCluster (2 worker processes) start-up, not included above: "
+            f"{startup:.1f} s."
+        )
     write_results("scaling_search", rows, notes=notes)
 
 

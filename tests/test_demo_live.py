@@ -9,7 +9,7 @@ from skmotion.io import read_bvh
 def test_live_section(tmp_path):
     pytest.importorskip("matplotlib")
     lines = []
-    context = run_demo(lines.append, sections=("skmotion._demo.live",), plot_dir=tmp_path)
+    context = run_demo(lines.append, sections=("skmotion._demo.live",), out=tmp_path)
     text = "\n".join(lines)
     assert "== A live database: clips added one by one, a stream, a sampled motion ==" in text
     assert "node path equal to the batch decode: True" in text

@@ -1,4 +1,5 @@
-"""Subject-wise evaluation: GroupKFold with the loaders' groups, and nested searches with routed groups.
+"""Subject-wise evaluation: GroupKFold with the loaders' groups, and nested searches with
+routed groups.
 
 The truth the tests check against does not come from the groups that sklearn routes:
 each clip's subject is looked up from the clip itself (by identity, in the original

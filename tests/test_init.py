@@ -32,7 +32,8 @@ def test_top_level_lists_every_public_subpackage():
 def test_import_is_light_and_loads_no_optional_dependency():
     code = (
         "import sys, skmotion, skmotion.datasets, skmotion.preprocessing, skmotion.kinematics; "
-        "heavy = [m for m in ('matplotlib', 'dask', 'distributed', 'mujoco', 'hmmlearn', 'tslearn') if m in sys.modules]; "
+        "heavy = [m for m in ('matplotlib', 'dask', 'distributed', 'mujoco', 'hmmlearn', "
+        "'tslearn') if m in sys.modules]; "
         "print(heavy)"
     )
     out = subprocess.run(

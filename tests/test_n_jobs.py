@@ -1,4 +1,5 @@
-"""n_jobs: every estimator's parallel path really runs, and gives bit-identical results to the serial one.
+"""n_jobs: every estimator's parallel path really runs, and gives bit-identical results to the
+serial one.
 
 Work is split into tasks of a fixed size (clips per chunk, leaves per task, frames
 per decoding group) that depend on the data only. The sizes are made small here so

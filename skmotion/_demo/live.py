@@ -113,7 +113,7 @@ def _sample_bvh(context, lines):
         transformer=transformer,
         frame_rate=walks.frame_rate,
     )
-    folder = getattr(context, "plot_dir", None) or tempfile.mkdtemp(prefix="skmotion-demo-")
+    folder = getattr(context, "out", None) or tempfile.mkdtemp(prefix="skmotion-demo-")
     path = Path(folder) / "sampled_walk.bvh"
     path.parent.mkdir(parents=True, exist_ok=True)
     write_bvh(sample.motion, path)
@@ -134,12 +134,11 @@ def run(context):
     model, X_test, y_test = _grow(data, clips, names, data.groups < 3, lines)
     proba, switch = _stream(model, X_test, y_test, lines)
     context.live_model, context.live_posterior = model, proba
-    if getattr(context, "plot_dir", None):
-        lines += save_figure(
-            context.plot_dir,
-            "stream_posterior.png",
-            _draw_posterior(model, proba, switch, data.frame_rate),
-            "the class posterior of the stream over time",
-        )
+    lines += save_figure(
+        context,
+        "stream_posterior.png",
+        _draw_posterior(model, proba, switch, data.frame_rate),
+        "the class posterior of the stream over time",
+    )
     _sample_bvh(context, lines)
     return lines

@@ -66,7 +66,8 @@ class ArmModel:
     >>> arm = ArmModel.from_skeleton(humanoid_skeleton(), ["RightArm", "RightForeArm"],
     ...                              dofs=["ZXY", "X"], end="RightHand_end")
     >>> arm.n_dof, arm.lengths.round(2).tolist(), arm.dof_names
-    (4, [0.29, 0.44], ('RightArm_Zrotation', 'RightArm_Xrotation', 'RightArm_Yrotation', 'RightForeArm_Xrotation'))
+    (4, [0.29, 0.44], ('RightArm_Zrotation', 'RightArm_Xrotation', 'RightArm_Yrotation',
+                       'RightForeArm_Xrotation'))
     """
 
     links: np.ndarray
@@ -214,7 +215,8 @@ class ArmModel:
         gravity[_UP[self.up_axis]] = -9.81
         lines = [
             '<mujoco model="skmotion_arm">',
-            f'  <option timestep="{timestep:.9g}" gravity="{_fmt(gravity)}" integrator="implicitfast"/>',
+            f'  <option timestep="{timestep:.9g}" gravity="{_fmt(gravity)}"'
+            ' integrator="implicitfast"/>',
             "  <worldbody>",
         ]
         k, indent, opened = 0, "    ", 0

@@ -137,7 +137,8 @@ def simulate_arm(trajectory, *, arm, frame_rate, kp=200.0, kd=20.0, timestep=0.0
     q_target = np.asarray(trajectory, dtype=float)
     if q_target.ndim != 2 or q_target.shape[1] != arm.n_dof or len(q_target) < 2:
         raise ValueError(
-            f"trajectory must have shape (n_frames >= 2, {arm.n_dof}) for this arm; got {q_target.shape}."
+            f"trajectory must have shape (n_frames >= 2, {arm.n_dof}) for this arm; "
+            f"got {q_target.shape}."
         )
     if not np.isfinite(q_target).all():
         frame, dof = np.argwhere(~np.isfinite(q_target))[0]

@@ -7,10 +7,10 @@ from sklearn.utils import Bunch
 
 from skmotion.datasets._synthetic import make_motions
 from skmotion.kinematics import forward_kinematics
-from skmotion.preprocessing._layouts import Layout
+from skmotion.kinematics._layouts import Layout
+from skmotion.kinematics._named_layouts import LAYOUTS, get_layout
 from skmotion.preprocessing._marker_presets import MARKER_NAMES, marker_preset
 from skmotion.preprocessing._marker_set import MarkerSet
-from skmotion.preprocessing._named_layouts import LAYOUTS, get_layout
 from skmotion.utils._sklearn_compat import Interval, StrOptions, validate_params
 
 __all__ = ["EXTRA_LANDMARKS", "layout_markers", "layout_positions", "make_position_motions"]

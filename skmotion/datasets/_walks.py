@@ -163,7 +163,8 @@ def make_walks(
     >>> data = make_walks(1, directions=["forward", "left"], random_state=0)
     >>> data.target_names.tolist(), data.clips[0].shape[1]
     (['forward', 'left'], 66)
-    >>> bool(data.root_velocity[0][:, 0].mean() > 1.0), bool(abs(data.root_velocity[1][:, 1].mean() - 0.55) < 0.1)
+    >>> forward, left = data.root_velocity[0], data.root_velocity[1]
+    >>> bool(forward[:, 0].mean() > 1.0), bool(abs(left[:, 1].mean() - 0.55) < 0.1)
     (True, True)
     """
     names = tuple(WALK_DIRECTIONS) if directions is None else tuple(directions)

@@ -2,7 +2,7 @@
 
 The joint names come from a *layout*: any object with a ``joint_names``
 sequence (the layouts of :mod:`skmotion.preprocessing` have one), or a layout
-name that :func:`skmotion.preprocessing.get_layout` resolves when called.
+name that :func:`skmotion.kinematics.get_layout` resolves.
 """
 
 import io
@@ -13,6 +13,7 @@ import numpy as np
 from skmotion.io._errors import MotionFileError
 from skmotion.io._motion import Motion
 from skmotion.io._text import read_bytes
+from skmotion.kinematics._named_layouts import get_layout
 
 __all__ = ["read_keypoints"]
 
@@ -26,9 +27,6 @@ def _joint_names(layout):
     if layout is None:
         return None
     if isinstance(layout, str):
-        # Resolved when called, so that io imports nothing from preprocessing at import time.
-        from skmotion.preprocessing import get_layout
-
         layout = get_layout(layout)
     names = getattr(layout, "joint_names", None)
     if names is None:
@@ -199,7 +197,7 @@ def read_keypoints(
         The file.
     layout : None, str or object with ``joint_names``, default=None
         The joints in file order: a layout name (resolved by
-        :func:`skmotion.preprocessing.get_layout`), or any object with a
+        :func:`skmotion.kinematics.get_layout`), or any object with a
         ``joint_names`` sequence. None takes the names from the file
         (``.npz`` ``joint_names``, a CSV header), else ``joint0, joint1, ...``.
     frame_rate : float

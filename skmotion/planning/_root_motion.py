@@ -1,4 +1,4 @@
-"""Root motion on the floor from body-frame marker velocities (paper 000, section V-C).
+"""Root motion on the floor from body-frame marker velocities (Yamane et al. 2011, section V-C).
 
 The database stores every marker's position ``p`` and velocity ``v`` in the
 moving body frame (origin on the floor below the root, ``x`` forward, ``y``

@@ -1,10 +1,11 @@
 """Preprocessing: clip-to-clip transformers and the steps that bridge to sklearn."""
 
+from skmotion.kinematics._layouts import Layout
+from skmotion.kinematics._named_layouts import LAYOUTS, get_layout
 from skmotion.preprocessing._body_frame import body_frame_features, body_size
 from skmotion.preprocessing._fill_gaps import FillGaps
 from skmotion.preprocessing._filter import LowPassFilter, filter_min_frames, lowpass_filter
 from skmotion.preprocessing._flatten import FlattenClips
-from skmotion.preprocessing._layouts import Layout
 from skmotion.preprocessing._marker_presets import (
     MARKER_NAMES,
     MARKER_PRESETS,
@@ -12,7 +13,6 @@ from skmotion.preprocessing._marker_presets import (
     marker_preset,
 )
 from skmotion.preprocessing._marker_set import Marker, MarkerSet
-from skmotion.preprocessing._named_layouts import LAYOUTS, get_layout
 from skmotion.preprocessing._resample import ResampleClips, resample_clip
 from skmotion.preprocessing._segment import (
     SEGMENTATION_RULES,

@@ -1,4 +1,4 @@
-"""Marker trajectories in the floor-level, facing-aligned body frame (paper 000, III-A)."""
+"""Marker trajectories in the floor-level, facing-aligned body frame (Yamane et al. 2011, III-A)."""
 
 import numpy as np
 

@@ -8,9 +8,9 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipTransformerMixin, MotionTags
+from skmotion.kinematics._layouts import Layout
+from skmotion.kinematics._named_layouts import LAYOUTS, get_layout
 from skmotion.preprocessing._gaps import fill_points, missing_points
-from skmotion.preprocessing._layouts import Layout
-from skmotion.preprocessing._named_layouts import LAYOUTS, get_layout
 from skmotion.utils._clips import check_clips
 from skmotion.utils._parallel import parallel_map
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context

@@ -8,28 +8,10 @@ subject. Clips of different skeletons then share one feature space.
 
 import numpy as np
 
+from skmotion.kinematics._marker_names import MARKER_NAMES
 from skmotion.preprocessing._marker_set import MarkerSet
 
 __all__ = ["MARKER_NAMES", "MARKER_PRESETS", "detect_marker_preset", "marker_preset"]
-
-_CENTRE = ("head_top", "head", "neck", "chest", "spine", "pelvis")
-_SIDE = (
-    "clavicle",
-    "shoulder",
-    "upper_arm",
-    "elbow",
-    "forearm",
-    "wrist",
-    "hand",
-    "hip",
-    "thigh",
-    "knee",
-    "shin",
-    "ankle",
-    "toe",
-)
-#: The 32 marker names shared by every preset: 6 on the trunk and head, 13 per side.
-MARKER_NAMES = _CENTRE + tuple(f"{side}_{part}" for side in ("left", "right") for part in _SIDE)
 
 
 # Marker specs. ("at", j): the joint's position. ("along", j, child, t): t of the way
@@ -225,8 +207,9 @@ def detect_marker_preset(skeleton):
     closest = min(MARKER_PRESETS, key=lambda p: len(_required_joints(p) - joints))
     missing = sorted(_required_joints(closest) - joints)
     raise ValueError(
-        f"No marker preset fits this skeleton (root {skeleton.joints[0]!r}, {skeleton.n_joints} joints); the "
-        f"closest, {closest!r}, lacks joints {missing[:6]}{' ...' if len(missing) > 6 else ''}. "
+        f"No marker preset fits this skeleton (root {skeleton.joints[0]!r}, "
+        f"{skeleton.n_joints} joints); the closest, {closest!r}, lacks joints "
+        f"{missing[:6]}{' ...' if len(missing) > 6 else ''}. "
         "Define the markers with a MarkerSet."
     )
 

@@ -76,7 +76,8 @@ class MarkerSet:
         offsets = np.array([np.asarray(m.offset, dtype=float) for m in rows])
         if offsets.shape != (len(rows), 3) or not np.isfinite(offsets).all():
             raise ValueError(
-                f"Each marker offset must be 3 finite numbers; got an array of shape {offsets.shape}."
+                "Each marker offset must be 3 finite numbers; got an array of shape "
+                f"{offsets.shape}."
             )
         offsets.setflags(write=False)
         self.names = names
@@ -125,8 +126,8 @@ class MarkerSet:
         if missing:
             marker, joint = missing[0]
             raise ValueError(
-                f"Marker {marker!r} is on joint {joint!r}, which the skeleton (root {skeleton.joints[0]!r}, "
-                f"{skeleton.n_joints} joints) does not have"
+                f"Marker {marker!r} is on joint {joint!r}, which the skeleton "
+                f"(root {skeleton.joints[0]!r}, {skeleton.n_joints} joints) does not have"
                 + (
                     f"; {len(missing) - 1} more markers have unknown joints."
                     if len(missing) > 1

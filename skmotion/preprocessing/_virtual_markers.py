@@ -9,10 +9,10 @@ from sklearn.utils.validation import check_is_fitted
 from skmotion.base import ClipTransformerMixin, MotionTags
 from skmotion.io._motion import Motion
 from skmotion.kinematics import Skeleton
-from skmotion.preprocessing._layouts import Layout, layout_plan
+from skmotion.kinematics._layouts import Layout, layout_plan
+from skmotion.kinematics._named_layouts import LAYOUTS, get_layout
 from skmotion.preprocessing._marker_presets import MARKER_NAMES, MARKER_PRESETS, marker_preset
 from skmotion.preprocessing._marker_set import MarkerSet
-from skmotion.preprocessing._named_layouts import LAYOUTS, get_layout
 from skmotion.preprocessing._position_frame import CHUNK, position_frame_features
 from skmotion.utils._clips import check_clips
 from skmotion.utils._parallel import parallel_map
@@ -29,7 +29,7 @@ class VirtualMarkerTransform(ClipTransformerMixin, BaseEstimator):
     """Joint-angle clips to virtual-marker clips in a body-centred frame.
 
     Each output frame holds, for every virtual marker, its position and
-    velocity ``(px, py, pz, vx, vy, vz)`` (paper 000, section III-A):
+    velocity ``(px, py, pz, vx, vy, vz)`` (Yamane et al. 2011, section III-A):
 
     1. forward kinematics gives each marker's world position (a marker is a
        point fixed on a joint's link, see :class:`MarkerSet`); its velocity

@@ -175,7 +175,8 @@ def low_rank_covariance(centred, scatter, sq_norms, reg):
     Examples
     --------
     >>> import numpy as np
-    >>> from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
+    >>> from skmotion.tree._gaussian import (
+    ...     centred_moments, estimate_covariance, low_rank_covariance)
     >>> frames = np.random.default_rng(0).normal(size=(4, 10))
     >>> mean, scatter, sq_norms = centred_moments(frames)
     >>> floor, vectors, values = low_rank_covariance(frames - mean, scatter, sq_norms, 1e-3)

@@ -326,11 +326,15 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.tree_ = tree
         self.n_layers_ = tree.n_layers
         self.n_nodes_ = tree.n_nodes
+        self._set_node_weights()
+        self.temperature_ = self._fit_temperature(clips, labels, offsets, y_index)
+        return self
+
+    def _set_node_weights(self):
+        """``log_node_weights_``: each node's share of the frames at ``layer_`` (novelty_score)."""
         visits = self.global_graph_.visits(self.layer_)[0]
         with np.errstate(divide="ignore"):
             self.log_node_weights_ = np.log(visits / visits.sum())
-        self.temperature_ = self._fit_temperature(clips, labels, offsets, y_index)
-        return self
 
     def _count_graphs(self, tree, labels, offsets, y_index):
         """The global graph, the classifying graphs and the class of each, from routed frames."""
@@ -809,7 +813,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         >>> from skmotion.tree import MotionTreeHMM
         >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
         >>> X = [clip[:, 6:] for clip in data.clips]
-        >>> model = MotionTreeHMM(max_depth=4).partial_fit(X[:2], data.target[:2])
+        >>> model = MotionTreeHMM(max_depth=4, min_samples_leaf=16)
+        >>> model = model.partial_fit(X[:2], data.target[:2])
         >>> for clip, label in zip(X[2:], data.target[2:]):
         ...     model = model.partial_fit([clip], [label])
         >>> int(model.tree_.count[0]) == sum(len(c) for c in X), model.score(X, data.target)
@@ -817,7 +822,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         """
         from skmotion.tree._partial_fit import partial_fit
 
-        return partial_fit(self, X, y, classes, split_growth, rebuild_tol)
+        partial_fit(self, X, y, classes, split_growth, rebuild_tol)
+        self._set_node_weights()  # the nodes and their frame counts have changed
+        return self
 
     def stream(self, *, layer=None, lag=0, window=None, n_best=3, mode="online", beam=None):
         """An online decoder: recognition and state estimation as frames arrive.

@@ -22,18 +22,11 @@ from numbers import Integral
 import numpy as np
 from sklearn.utils import Bunch
 
+from skmotion.tree._calibration import log_softmax_rows, per_frame
 from skmotion.tree._decode import beam_decode
 from skmotion.tree._transitions import TransitionGraphs
 
 __all__ = ["MotionStream"]
-
-
-def _log_normalise(a):
-    """``a - log sum exp(a)`` along the last axis (``-inf`` stays ``-inf``)."""
-    top = np.max(a, axis=-1, keepdims=True)
-    top[~np.isfinite(top)] = 0.0
-    with np.errstate(divide="ignore"):
-        return a - (np.log(np.sum(np.exp(a - top), axis=-1, keepdims=True)) + top)
 
 
 def _sum_of_paths(scores):
@@ -178,7 +171,7 @@ class MotionStream:
             len(model.score_layers_),
             False,
         )
-        return self._class_posterior(scores)
+        return self._class_posterior(scores, len(frames))
 
     def _scores_and_path(self, frames):
         """Class log posterior, global paths and their scores at the stream's layer."""
@@ -190,10 +183,13 @@ class MotionStream:
         paths, scores = self._decode(
             frames, self._combined, n_graphs, model.layer_, len(model.score_layers_), True
         )
-        return self._class_posterior(scores[:-1]), paths[-1], scores[-1, -1]
+        return self._class_posterior(scores[:-1], len(frames)), paths[-1], scores[-1, -1]
 
-    def _class_posterior(self, scores):
-        """The normalised class log probabilities from each class (clip) graph's path scores."""
+    def _class_posterior(self, scores, n_frames):
+        """Class log probabilities from each class (clip) graph's path scores, as ``predict_proba``.
+
+        The model's calibration: per-frame scores over its ``temperature_``, then a softmax.
+        """
         model = self.model
         per_graph = _sum_of_paths(scores).sum(axis=1)
         if model.graph == "class":
@@ -201,7 +197,8 @@ class MotionStream:
         else:
             log_prob = np.full(len(model.classes_), -np.inf)
             np.maximum.at(log_prob, model.graph_classes_, per_graph)
-        return _log_normalise(log_prob)
+        scores = per_frame(log_prob[None], [n_frames]) / model.temperature_
+        return log_softmax_rows(scores)[0]
 
     def update(self, frames):
         """Take one frame ``(n_channels,)`` or a chunk ``(n_frames, n_channels)``; the state now.
@@ -243,7 +240,7 @@ class MotionStream:
         class_log_proba, paths, scores = self._scores_and_path(frames)
         best = paths[0]
         node = int(best[-1])
-        log_w = _log_normalise(scores)
+        log_w = log_softmax_rows(scores[None])[0]  # as predict_next weighs the paths
         current = np.zeros(int(model.tree_.n_nodes[self.layer]))
         valid = paths[:, -1] >= 0
         np.add.at(current, paths[valid, -1], np.exp(log_w[valid]))

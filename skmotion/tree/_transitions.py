@@ -156,7 +156,8 @@ class TransitionGraphs(VersionedStateMixin):
         return np.ascontiguousarray(table.transpose(1, 2, 0)).ravel()
 
     def _sorted_keys(self, layer):
-        """Flat index in the ``(n_graphs, K + 1, K + 1)`` table of every stored count, increasing."""
+        """Flat index in the ``(n_graphs, K + 1, K + 1)`` table of every stored count,
+        increasing."""
         csr = self._counts[layer]
         k = csr.shape[1]
         rows = np.repeat(np.arange(csr.shape[0], dtype=np.int64), np.diff(csr.indptr))
@@ -240,7 +241,6 @@ class TransitionGraphs(VersionedStateMixin):
 
     def matrix(self, layer, graph):
         """The dense ``(K, K)`` transition probabilities of one graph (small layers)."""
-        k = self.n_nodes(layer)
         table = self.counts(layer, graph).toarray().astype(np.float64) + self.pseudo_count(layer)
         return table / (self._totals[layer][graph] + self.smoothing)[:, None]
 
@@ -261,7 +261,6 @@ class TransitionGraphs(VersionedStateMixin):
         -------
         distribution : ndarray of shape (..., K)
         """
-        k = self.n_nodes(layer)
         counts = self.counts(layer, graph)
         scale = 1.0 / (self._totals[layer][graph] + self.smoothing)
         unseen = self.pseudo_count(layer) * scale

@@ -34,7 +34,8 @@ def written_amc(n_frames=4):
 
 def written_ts():
     text = "#toy\n@problemName toy\n@univariate false\n@dimensions 2\n@equalLength false\n"
-    text += "@classLabel true walk run\n@data\n1.5,2,3:4,5,6:walk\n7,8:9,10:run\n0.25,-1,2,3:1,1,1,1:walk\n"
+    text += "@classLabel true walk run\n@data\n1.5,2,3:4,5,6:walk\n7,8:9,10:run\n"
+    text += "0.25,-1,2,3:1,1,1,1:walk\n"
     return text.encode()
 
 

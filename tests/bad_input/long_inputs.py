@@ -39,7 +39,10 @@ def write_long_bvh(path, n_frames, precision=6):
 
 
 def write_long_amc(folder, n_frames, seed=0):
-    """The toy ASF skeleton and an AMC file of ``n_frames`` frames (degrees); returns (asf, amc, values)."""
+    """The toy ASF skeleton and an AMC file of ``n_frames`` frames (degrees).
+
+    Returns (asf, amc, values).
+    """
     rng = np.random.default_rng(seed)
     values = np.round(rng.uniform(-60, 60, size=(n_frames, 12)), 6)
     asf, amc = folder / "toy.asf", folder / "long.amc"

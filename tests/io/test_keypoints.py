@@ -144,17 +144,14 @@ def test_missing_values_and_options(tmp_path):
         read_keypoints(tmp_path / "empty.txt", frame_rate=10, columns="xyz")
 
 
-def test_a_layout_name_is_resolved_by_preprocessing(tmp_path, frames, monkeypatch):
-    """The seam with the layouts module: a name goes through skmotion.preprocessing.get_layout."""
-    import skmotion.preprocessing as preprocessing
+def test_a_layout_name_gives_the_layouts_joint_names(tmp_path):
+    """A layout name is resolved by skmotion.kinematics.get_layout: its joints name the channels."""
+    from skmotion.kinematics import get_layout
 
-    asked = []
-
-    def get_layout(name):
-        asked.append(name)
-        return LAYOUT
-
-    monkeypatch.setattr(preprocessing, "get_layout", get_layout, raising=False)
-    np.save(tmp_path / "a.npy", frames)
-    motion = read_keypoints(tmp_path / "a.npy", "kinect_v1", frame_rate=30)
-    assert asked == ["kinect_v1"] and motion.marker_names == tuple(LAYOUT.joint_names)
+    layout = get_layout("kinect_v1")
+    frames = np.arange(5 * 20 * 3, dtype=float).reshape(5, 20, 3)
+    np.save(tmp_path / "k.npy", frames)
+    motion = read_keypoints(tmp_path / "k.npy", "kinect_v1", frame_rate=30)
+    assert motion.marker_names == tuple(layout.joint_names)
+    assert motion.channels.shape == (5, 60)
+    np.testing.assert_array_equal(motion.channels, frames.reshape(5, 60))

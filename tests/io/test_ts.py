@@ -4,7 +4,10 @@ import pytest
 from skmotion.datasets import load_uea
 from skmotion.io import MotionFileError, read_ts
 
-HEADER = "# a comment\n@problemName toy\n@timeStamps false\n@missing true\n@univariate false\n@dimensions 2\n"
+HEADER = (
+    "# a comment\n@problemName toy\n@timeStamps false\n@missing true\n@univariate false\n"
+    "@dimensions 2\n"
+)
 
 
 def _write(tmp_path, body, header=HEADER, name="toy.ts"):
@@ -16,7 +19,8 @@ def _write(tmp_path, body, header=HEADER, name="toy.ts"):
 def test_unequal_lengths_missing_values_and_labels(tmp_path):
     path = _write(
         tmp_path,
-        "@equalLength false\n@classLabel true walk run\n@data\n1,2,3:4,?,6:walk\n\n7,8:9,1e-3:run\n",
+        "@equalLength false\n@classLabel true walk run\n@data\n"
+        "1,2,3:4,?,6:walk\n\n7,8:9,1e-3:run\n",
     )
     clips, labels = read_ts(path)
     np.testing.assert_array_equal(clips[0], [[1, 4], [2, np.nan], [3, 6]])

@@ -1,4 +1,5 @@
-"""VirtualMarkerTransform: invariances, exact velocities, skeletons per clip, sklearn citizenship."""
+"""VirtualMarkerTransform: invariances, exact velocities, skeletons per clip, sklearn
+citizenship."""
 
 import numpy as np
 import pytest
@@ -122,7 +123,8 @@ def test_a_bigger_subject_gives_the_same_output():
 @pytest.mark.parametrize("frame_rate", [30.0, 120.0])
 @pytest.mark.parametrize("turn", [0.0, 0.4])
 def test_velocity_of_a_marker_at_constant_world_velocity_is_exact(frame_rate, turn):
-    """Marker positions as input (skeleton=None), y up; facing may turn, the marker moves straight."""
+    """Marker positions as input (skeleton=None), y up; facing may turn, the marker moves
+    straight."""
     n = 9
     t = np.arange(n) / frame_rate
     heading = 0.3 + turn * t  # the subject turns at ``turn`` rad/s
@@ -205,7 +207,8 @@ def test_each_motion_uses_its_own_skeleton():
 
 
 def test_clips_of_different_skeleton_families_share_the_markers():
-    """The humanoid renamed to the common BVH naming gets the common_bvh preset: same names, same body parts."""
+    """The humanoid renamed to the common BVH naming gets the common_bvh preset: same names,
+    same body parts."""
     clip, sk = _walk(6)
     renamed = {
         "LeftToe": "LeftToeBase",

@@ -91,7 +91,8 @@ def test_unknown_kind():
 
 @pytest.mark.parametrize("n, d", [(1, 6), (2, 6), (5, 20), (12, 192), (20, 20)])
 def test_the_low_rank_form_is_the_full_estimate(n, d):
-    """floor I + V^T diag(values) V is the Ledoit-Wolf estimate (sklearn's), and V has the frames' rank."""
+    """floor I + V^T diag(values) V is the Ledoit-Wolf estimate (sklearn's), and V has the
+    frames' rank."""
     X = np.random.default_rng(d + n).normal(size=(n, d)) @ np.diag(np.linspace(0.1, 3, d)) + 5.0
     mean, scatter, sq_norms = centred_moments(X)
     floor, vectors, values = low_rank_covariance(X - mean, scatter, sq_norms, 1e-3)

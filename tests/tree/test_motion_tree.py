@@ -24,6 +24,7 @@ def motion_frames():
 def check_partition(tree, frames):
     """Every layer holds every frame once; routed frames give the stored statistics."""
     n = len(frames)
+    previous = None  # the labels of the layer above (the root layer has none)
     for layer, labels in enumerate(tree.iter_apply(frames)):
         counts = np.bincount(labels, minlength=tree.n_nodes[layer])
         np.testing.assert_array_equal(counts, tree.counts(layer))

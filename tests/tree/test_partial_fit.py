@@ -146,7 +146,7 @@ def test_grown_leaves_split_by_the_build_rule():
     assert new_splits
     for node in new_splits:
         mine = frames[tree.layers[tree.depth[node]][paths[tree.depth[node]]] == node]
-        alone = MotionTree.build(mine, max_depth=1, min_samples_leaf=8)
+        alone = MotionTree.build(mine, max_depth=1, min_samples_leaf=8, split=model.split)
         np.testing.assert_allclose(alone.axis[0], tree.axis[node], rtol=1e-9, atol=1e-12)
         np.testing.assert_allclose(alone.threshold[0], tree.threshold[node], rtol=1e-9)
 
@@ -161,7 +161,7 @@ def test_drifted_nodes_are_rebuilt_from_their_frames():
     # (standardised as the first batch was)
     order = walk + rest
     frames = np.concatenate([(CLIPS[i] - model.center_) / model.scale_ for i in order])
-    whole = MotionTree.build(frames, max_depth=4, min_samples_leaf=8)
+    whole = MotionTree.build(frames, max_depth=4, min_samples_leaf=8, split=model.split)
     assert tree.n_tree_nodes == whole.n_tree_nodes
     np.testing.assert_allclose(tree.threshold, whole.threshold, rtol=1e-9)
     check_against_one_shot(model, [CLIPS[i] for i in order], LABELS[order])
@@ -248,3 +248,17 @@ def test_splits_and_rebuilds_keep_statistics_and_graphs_exact(graph):
     assert model.tree_.n_tree_nodes != before  # the structure changed on the way
     assert "zzz" in model.classes_
     check_against_one_shot(model, CLIPS, LABELS)
+
+
+def test_novelty_follows_the_grown_database():
+    """After leaves split, novelty_score weighs the new nodes by their share of all frames."""
+    model = MotionTreeHMM(max_depth=5, min_samples_leaf=8)
+    rest = list(range(1, 4)) + list(range(5, len(CLIPS)))
+    grow(model, CLIPS, LABELS, [[0, 4], rest], split_growth=1.5)
+    assert model.tree_.n_layers > 1
+    visits = model.global_graph_.visits(model.layer_)[0]
+    assert model.log_node_weights_.shape == (model.tree_.n_nodes[model.layer_],)
+    np.testing.assert_allclose(np.exp(model.log_node_weights_), visits / visits.sum())
+    typical = model.novelty_score(CLIPS)
+    moved = model.novelty_score([c + 10 * model.scale_ for c in CLIPS])
+    assert np.all(moved < typical)

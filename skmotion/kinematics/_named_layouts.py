@@ -8,7 +8,7 @@ layout and ``docs/positions.md``): Kinect v1/v2 ``JointType``, Azure Kinect
 
 from dataclasses import replace
 
-from skmotion.preprocessing._layouts import Layout
+from skmotion.kinematics._layouts import Layout
 
 __all__ = ["LAYOUTS", "get_layout"]
 

@@ -6,7 +6,7 @@ joints give the root, the facing direction and the body size, where each joint
 sits on the body (a landmark name; those among the 32 :data:`MARKER_NAMES` put
 clips of different systems into one feature space) and which joints move as
 one rigid segment (for gap filling). The named layouts follow each system's
-documentation (:mod:`skmotion.preprocessing._named_layouts`); the sources are
+documentation (:mod:`skmotion.kinematics._named_layouts`); the sources are
 listed in ``docs/positions.md``.
 """
 
@@ -14,7 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from skmotion.preprocessing._marker_presets import MARKER_NAMES
+from skmotion.kinematics._marker_names import MARKER_NAMES
 
 __all__ = ["Layout", "layout_plan"]
 
@@ -209,7 +209,7 @@ def layout_plan(layout, markers="auto"):
     Examples
     --------
     >>> from skmotion.preprocessing import get_layout
-    >>> from skmotion.preprocessing._layouts import layout_plan
+    >>> from skmotion.kinematics._layouts import layout_plan
     >>> plan = layout_plan(get_layout("coco17"))
     >>> plan["names"][:3], plan["root"]
     (('left_shoulder', 'left_elbow', 'left_wrist'), (11, 12))
