@@ -218,3 +218,47 @@ def test_progress_on_stderr_only_when_asked(tmp_path, capsys):
     assert re.search(r"\[skmotion\] baseline CV.*\d+/\d+", err)  # the folds, as they finish
     run_demo(lambda line: None, sections=sections, data_folder=str(root))
     assert capsys.readouterr().err == ""
+
+
+def _write_c3d_folder(root):
+    """C3D files of Kinect v2 joint positions (mm), named by class and subject."""
+    import warnings
+
+    c3d = pytest.importorskip("c3d")
+    from skmotion.datasets import make_position_motions
+    from skmotion.kinematics import get_layout
+
+    data = make_position_motions("kinect_v2", n_clips_per_class=4, random_state=0)
+    joints = list(get_layout("kinect_v2").joints)
+    names = np.asarray(data.target_names)[data.target]
+    for i, clip in enumerate(data.clips):
+        writer = c3d.Writer(point_rate=float(data.frame_rate), analog_rate=0.0, point_scale=-1.0)
+        writer.set_point_labels(joints)
+        frames = []
+        for xyz in clip.reshape(len(clip), -1, 3) * 1000.0:
+            points = np.zeros((len(joints), 5), np.float32)
+            points[:, :3] = xyz
+            frames.append((points, np.zeros((0, 0))))
+        writer.add_frames(frames)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            with open(root / f"{names[i]}_{i:02d}.c3d", "wb") as handle:
+                writer.write(handle)
+
+
+def test_a_folder_of_joint_positions_runs_on_its_layout(tmp_path):
+    """C3D positions: the layout is found, markers come from it, sections say what they skip."""
+    _write_c3d_folder(tmp_path)
+    lines = []
+    sections = tuple(
+        f"skmotion._demo.{name}"
+        for name in ("data_folder", "markers", "recognition", "checks", "live")
+    )
+    run_demo(lines.append, sections=sections, data_folder=str(tmp_path))
+    text = "\n".join(lines)
+    assert "28 clips (28 C3D)" in text
+    assert "joint positions (the kinect_v2 layout)" in text
+    assert "placed by the kinect_v2 layout" in text
+    assert re.search(r"tested on .*: accuracy [01]\.\d{3}", text)
+    assert "truncated C3D: MotionFileError: " in text
+    assert f"not run on {tmp_path}" in text  # the live section says it is skipped, and why

@@ -143,3 +143,19 @@ def test_plan_is_drawn_with_x_ahead_and_y_left():
         "goal",
         "heading",
     ]
+
+
+@pytest.mark.parametrize("name", ["kinect_v2", "mediapipe_pose33"])
+def test_a_named_layout_is_drawn_upright_with_its_own_bones(name):
+    """A layout's bones and up axis (signed: MediaPipe's y points down) give an upright figure."""
+    from skmotion.datasets import make_position_motions
+    from skmotion.kinematics import get_layout
+
+    layout = get_layout(name)
+    clip = make_position_motions(name, n_clips_per_class=1, random_state=0).clips[0]
+    body = body_frames(clip[:5], layout)
+    assert len(body.bones) == len(layout.bones)
+    on = {m: j for j, m in layout.shared_markers}
+    shoulder, ankle = layout.index(on["left_shoulder"]), layout.index(on["left_ankle"])
+    # the shoulder is above the ankle along the drawn up axis, whichever sign the layout uses
+    assert (body.positions[:, shoulder, body.up] > body.positions[:, ankle, body.up]).all()

@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 
 from skmotion.decomposition import SVDFeatureExtractor
-from skmotion.io import Motion, as_motions, read_bvh, write_bvh
+from skmotion.io import Motion, as_motions, file_format, read_bvh, write_bvh
 from skmotion.preprocessing import ResampleClips
 from skmotion.tree import MotionTreeHMM
 
@@ -36,6 +36,15 @@ def _truncated_bvh(motion, folder):
     return path
 
 
+def _truncated_copy(filename, folder):
+    """The first half of a file's bytes, under its own name, and the reader of its format."""
+    source = Path(filename)
+    path = Path(folder) / source.name
+    data = source.read_bytes()
+    path.write_bytes(data[: len(data) // 2])
+    return path, file_format(source).reader
+
+
 def run(context):
     data = context.data
     # The data's own clips (synthetic, or --data FOLDER's), made bad in each way.
@@ -60,13 +69,17 @@ def run(context):
         ("one clip, not a list", lambda: ResampleClips(n_frames=8).fit(clip)),
     ]
     with tempfile.TemporaryDirectory() as folder:
-        path = _truncated_bvh(motion, folder)
-        tried.append(("truncated BVH", lambda: read_bvh(path)))
+        if motion.skeleton is None:  # positions: the folder's own first file, cut in half
+            path, read = _truncated_copy(data.filenames[0], folder)
+            tried.append((f"truncated {path.suffix[1:].upper()}", lambda: read(path)))
+        else:
+            path = _truncated_bvh(motion, folder)
+            tried.append(("truncated BVH", lambda: read_bvh(path)))
         lines = [
             f"{what:>20}: {_message(call).replace(str(path), path.name)}" for what, call in tried
         ]
     return (
-        [f"bad inputs made from {source}; the BVH from the first clip's motion:"]
+        [f"bad inputs made from {source}; the file from the first clip's motion:"]
         + lines
         + ["(every estimator and reader, with many more cases: tests/bad_input/, docs/errors.md)"]
     )

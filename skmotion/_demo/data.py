@@ -18,7 +18,12 @@ def body_figures(context, clip, skeleton, frame_rate, what):
         context,
         "pose.png",
         lambda plotting: plotting.plot_pose(clip[0], skeleton, title=f"first pose of {what}"),
-        f"the first pose of {what} (forward kinematics of its joint angles)",
+        f"the first pose of {what} "
+        + (
+            "(forward kinematics of its joint angles)"
+            if hasattr(skeleton, "forward_kinematics")
+            else f"(joint positions, bones of the {skeleton.name} layout)"
+        ),
     )
     lines += save_figure(
         context,

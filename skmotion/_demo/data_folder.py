@@ -8,6 +8,7 @@ keyword in their own name, and only then by their folder's name; the report coun
 
 import inspect
 import re
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -23,6 +24,8 @@ from skmotion.datasets import (
     motion_class_of_name,
     read_cmu_index,
 )
+from skmotion.io import file_format
+from skmotion.kinematics import LAYOUTS, get_layout
 from skmotion.preprocessing import FlattenClips, ResampleClips, resample_clip, to_markers
 
 TITLE = "Data: motion files"
@@ -117,11 +120,26 @@ def _label_lines(sources, index_path):
     ]
 
 
+def matching_layout(motion):
+    """The named layout whose joints are the position motion's markers, in order, or None."""
+    for name in LAYOUTS:
+        layout = get_layout(name)
+        if tuple(layout.joints) == tuple(motion.marker_names) and layout.dim == 3:
+            return layout
+    return None
+
+
 def _figure_lines(context, motions, filenames, labels):
-    """Stick figures of the folder's first clip, at its own frame rate and skeleton."""
+    """Stick figures of the folder's first clip, at its own frame rate and skeleton (or layout)."""
     motion = motions[0]
     what = f"{Path(filenames[0]).name} ({labels[0]})"
-    return body_figures(context, motion.channels, motion.skeleton, motion.frame_rate, what)
+    body = motion.skeleton if motion.skeleton is not None else context.data.layout
+    if body is None:
+        return [
+            "figures: skipped (position clips whose joints match no named layout: "
+            "skmotion.kinematics.LAYOUTS, or a Layout of your own, says how to join them)"
+        ]
+    return body_figures(context, motion.channels, body, motion.frame_rate, what)
 
 
 def run(context):
@@ -137,7 +155,17 @@ def run(context):
     subject_names, groups = np.unique(np.asarray(subjects, dtype=object), return_inverse=True)
     motions = data.motions
     layouts = {tuple(m.channel_names) for m in motions}
-    if len(layouts) == 1:
+    position_layout = None
+    if all(m.skeleton is None for m in motions):
+        # Joint positions (C3D, keypoint files): no skeleton; a known layout names the body.
+        position_layout = matching_layout(motions[0]) if len(layouts) == 1 else None
+        kind = "joint positions" + (
+            f" (the {position_layout.name} layout)" if position_layout else " (no known layout)"
+        )
+        clips = [to_rate(m.channels, m.frame_rate, rate) for m in motions]
+        feature_names = list(motions[0].channel_names)
+        skeleton = None
+    elif len(layouts) == 1:
         kind = "joint angles"
         clips = [to_rate(_unwrapped(m), m.frame_rate, rate) for m in motions]
         feature_names = list(motions[0].channel_names)
@@ -159,6 +187,7 @@ def run(context):
         motions=motions,
         skeletons=data.skeletons,
         skeleton=skeleton,
+        layout=position_layout,
         feature_names=feature_names,
         filenames=data.filenames,
         label_sources=sources,
@@ -170,11 +199,13 @@ def run(context):
     context.evaluation = evaluation
     lengths = np.array([len(c) for c in clips])
     rates = sorted({m.frame_rate for m in motions})
-    n_bvh = sum(str(f).lower().endswith(".bvh") for f in data.filenames)
+    formats = Counter(file_format(f).name for f in data.filenames)
     rate_text = ", ".join(f"{r:g}" for r in rates)
+    n_skeletons = len({m.skeleton for m in motions} - {None})
     lines = [
-        f"{context.data_folder}: {len(motions)} clips ({n_bvh} BVH, {len(motions) - n_bvh} "
-        f"ASF/AMC), {len({m.skeleton for m in motions})} skeletons, recorded at {rate_text} Hz",
+        f"{context.data_folder}: {len(motions)} clips ("
+        + ", ".join(f"{n} {name}" for name, n in formats.items())
+        + f"), {n_skeletons} skeletons, recorded at {rate_text} Hz",
         f"resampled to {rate:g} Hz: {lengths.sum():,} frames ({lengths.sum() / rate:.1f} s); "
         f"clip length min {lengths.min()}, median {int(np.median(lengths))}, max {lengths.max()}",
         f"channels: {len(feature_names)} {kind}",

@@ -127,6 +127,14 @@ def _sample_bvh(context, lines):
 
 
 def run(context):
+    folder = getattr(context, "data_folder", None)
+    if folder:
+        return [
+            f"not run on {folder}: this walk-through adds the built-in motion classes one by one, "
+            "streams a walk into a jump and samples a walk for the humanoid skeleton; run "
+            "`skmotion demo` without --data to see it (MotionTreeHMM.partial_fit, stream and "
+            "sample work on any clips: docs/live-database.md)"
+        ]
     data = make_motions(n_clips_per_class=8, classes=_CLASSES, random_state=context.random_state)
     clips = [c[:, 6:] for c in data.clips]  # joint angles without the root
     names = data.target_names[data.target]

@@ -14,9 +14,9 @@ from skmotion._demo._split import evaluation_of
 from skmotion._demo.data_folder import to_rate
 from skmotion.io import as_motions
 from skmotion.preprocessing import (
-    MARKER_NAMES,
     FlattenClips,
     ResampleClips,
+    VirtualMarkerTransform,
     detect_marker_preset,
     to_markers,
 )
@@ -24,24 +24,42 @@ from skmotion.preprocessing import (
 TITLE = "Virtual markers: positions and velocities in the body frame"
 
 
-def run(context):
+def _markers(context):
+    """Body-frame marker clips, their names and how they were placed (or why they cannot be)."""
     data = context.data
+    if data.get("skeleton") is None and "layout" in data and data.get("motions"):
+        if data.layout is None:
+            return None, None, "position clips whose joints match no named layout"
+        transform = VirtualMarkerTransform(layout=data.layout, frame_rate=data.frame_rate)
+        clips = transform.fit_transform(data.clips)
+        return clips, list(transform.marker_names_), f"the {data.layout.name} layout"
     motions = data.get("motions") or as_motions(data.clips, data.skeletons, data.frame_rate)
     presets = Counter(detect_marker_preset(m.skeleton) for m in motions)
     marker_clips, names = to_markers(motions)
     clips = [to_rate(c, m.frame_rate, data.frame_rate) for c, m in zip(marker_clips, motions)]
+    how = "the preset of each clip's skeleton: " + ", ".join(
+        f"{p} {n} clips" for p, n in presets.items()
+    )
+    return clips, [n[:-3] for n in names[::6]], how
+
+
+def run(context):
+    data = context.data
+    clips, markers, how = _markers(context)
     context.marker_clips = clips
-    n_markers = len(names) // 6
+    if clips is None:
+        return [f"not run: {how} (skmotion.kinematics.LAYOUTS, or a Layout of your own)"]
+    n_markers = len(markers)
     frames = np.concatenate(clips).reshape(-1, n_markers, 6)
     height = {
-        name: np.median(frames[:, MARKER_NAMES.index(name), 2])
-        for name in ("head_top", "pelvis", "left_knee")
+        name: np.median(frames[:, markers.index(name), 2])
+        for name in ("head_top", "head", "pelvis", "left_knee")
+        if name in markers
     }
-    speed = np.median(np.linalg.norm(frames[:, MARKER_NAMES.index("pelvis"), 3:5], axis=1))
+    speed = np.median(np.linalg.norm(frames[:, markers.index("pelvis"), 3:5], axis=1))
     lines = [
-        f"{n_markers} markers ({', '.join(MARKER_NAMES[:6])}, ...) placed by the preset of each "
-        f"clip's skeleton: " + ", ".join(f"{p} {n} clips" for p, n in presets.items()),
-        f"output: {len(names)} channels per frame (px py pz vx vy vz per marker; x forward, "
+        f"{n_markers} markers ({', '.join(markers[:6])}, ...) placed by {how}",
+        f"output: {6 * n_markers} channels per frame (px py pz vx vy vz per marker; x forward, "
         "y left, z up; lengths in body heights)",
         "median height over all frames: "
         + ", ".join(f"{k} {v:.2f}" for k, v in height.items())

@@ -16,6 +16,11 @@ import numpy as np
 
 from skmotion.kinematics._marker_names import MARKER_NAMES
 
+# The shared markers along which a layout's stick figure is drawn (see Layout.bones).
+_TRUNK = ("pelvis", "spine", "chest", "neck", "head", "head_top")  # from the root up
+_ARM = ("clavicle", "shoulder", "upper_arm", "elbow", "forearm", "wrist", "hand")
+_LEG = ("hip", "thigh", "knee", "shin", "ankle", "toe")
+
 __all__ = ["Layout", "layout_plan"]
 
 _UP = ("x", "y", "z", "-x", "-y", "-z")
@@ -148,6 +153,44 @@ class Layout:
         """``(joint, marker)`` pairs on the shared markers, in :data:`MARKER_NAMES` order."""
         on = {m: j for j, m in self.landmarks if m in MARKER_NAMES}
         return tuple((on[m], m) for m in MARKER_NAMES if m in on)
+
+    @property
+    def bones(self):
+        """Pairs of joints to draw as a stick figure, from the joints' places on the body.
+
+        The layouts list no bones of their own; joints on the shared markers are
+        joined along the trunk (pelvis to head top, so the first bone starts at the
+        root), each arm (from the neck, or the
+        chest or spine where the layout has no neck, to the hand) and each leg (from
+        the pelvis, or the spine, to the toe), skipping the markers the layout lacks;
+        a layout with no trunk joint gets a torso of shoulders and hips. Joints on
+        other landmarks (eyes, ears, fingers) stay unjoined.
+
+        Returns
+        -------
+        bones : tuple of (str, str)
+            ``(parent joint, child joint)`` pairs.
+
+        Examples
+        --------
+        >>> from skmotion.kinematics import get_layout
+        >>> get_layout("kinect_v2").bones[:2]
+        (('SpineBase', 'SpineMid'), ('SpineMid', 'SpineShoulder'))
+        """
+        on = {m: j for j, m in self.landmarks if m in MARKER_NAMES}
+        chains = [[on[m] for m in _TRUNK if m in on]]
+        for side in ("left", "right"):
+            for anchors, parts in ((("neck", "chest", "spine"), _ARM), (("pelvis", "spine"), _LEG)):
+                start = [next((on[a] for a in anchors if a in on), None)]
+                limb = [on[f"{side}_{p}"] for p in parts if f"{side}_{p}" in on]
+                chains.append([j for j in start if j is not None] + limb if limb else [])
+        bones = [pair for chain in chains for pair in zip(chain[:-1], chain[1:])]
+        if not chains[0]:  # no trunk (COCO, MediaPipe): a torso from the limbs' first joints,
+            # hips first, so that the first bone starts at the root as in the other layouts
+            la, ll, ra, rl = (chain[0] if chain else None for chain in chains[1:])
+            torso = ((ll, rl), (ll, la), (rl, ra), (la, ra))
+            bones = [(a, b) for a, b in torso if a and b] + bones
+        return tuple(bones)
 
     def landmark(self, joint):
         """The landmark a joint sits on, or None.

@@ -181,8 +181,12 @@ def body_frames(frames, body=None, *, bones=None, up_axis=None):
         bone_pairs = _bones_from_pairs(given, names, n_joints)
     up = None
     if positions.shape[2] == 3:
-        axis = up_axis or getattr(body, "up_axis", None) or "z"
-        if axis not in _AXES:
+        # a Skeleton names its up_axis, a layout its `up` (signed: "-y" for image-like y down)
+        axis = up_axis or getattr(body, "up_axis", None) or getattr(body, "up", None) or "z"
+        if axis.lstrip("-") not in _AXES:
             raise ValueError(f"up_axis must be 'x', 'y' or 'z'; got {axis!r}.")
-        up = _AXES.index(axis)
+        up = _AXES.index(axis.lstrip("-"))
+        if axis.startswith("-"):
+            positions = positions.copy()
+            positions[:, :, up] *= -1
     return BodyFrames(positions, bone_pairs, names, up, unit)

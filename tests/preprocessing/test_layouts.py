@@ -282,3 +282,27 @@ def test_joint_angle_clips_times_1e150_raise_a_clear_error():
     vmt = VirtualMarkerTransform(skeleton, frame_rate=30.0).fit([angles])
     with pytest.raises(ValueError, match="clip 0: the body size .* lost in floating-point"):
         vmt.transform([angles * 1e150])
+
+
+@pytest.mark.parametrize("name", sorted(LAYOUTS))
+def test_layout_bones_join_the_body_into_one_tree_or_torso(name):
+    """Bones join joints of the layout; the joints on the shared markers form one connected body."""
+    layout = get_layout(name)
+    bones = layout.bones
+    assert all(a in layout.joints and b in layout.joints and a != b for a, b in bones)
+    on_markers = {j for j, _ in layout.shared_markers}
+    joined = {j for bone in bones for j in bone}
+    assert joined <= on_markers
+    # connected: a walk over the bones from any joint reaches every joined joint
+    seen, todo = set(), [bones[0][0]]
+    while todo:
+        joint = todo.pop()
+        if joint not in seen:
+            seen.add(joint)
+            todo += [b if a == joint else a for a, b in bones if joint in (a, b)]
+    assert seen == joined
+    # limbs run from the body outwards: each wrist and ankle is a bone's child, never a parent
+    for end in ("left_wrist", "right_wrist", "left_ankle", "right_ankle"):
+        joint = {m: j for j, m in layout.shared_markers}.get(end)
+        if joint is not None:
+            assert any(b == joint for _, b in bones)
