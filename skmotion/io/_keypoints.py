@@ -1,6 +1,6 @@
 """Reading keypoint files: joint positions per frame from trackers and pose estimators.
 
-The joint names come from a *layout*: any object with a ``joint_names``
+The joint names come from a *layout*: a :class:`~skmotion.kinematics.Layout` or any object with ``joints`` or ``joint_names``
 sequence (the layouts of :mod:`skmotion.preprocessing` have one), or a layout
 name that :func:`skmotion.kinematics.get_layout` resolves.
 """
@@ -28,10 +28,11 @@ def _joint_names(layout):
         return None
     if isinstance(layout, str):
         layout = get_layout(layout)
-    names = getattr(layout, "joint_names", None)
+    # a skmotion Layout names its joints `joints`; other layout objects may say `joint_names`
+    names = getattr(layout, "joints", None) or getattr(layout, "joint_names", None)
     if names is None:
         raise TypeError(
-            f"layout must be None, a layout name or an object with joint_names; got "
+            f"layout must be None, a layout name or an object with joints (or joint_names); got "
             f"{type(layout).__name__}."
         )
     return [str(n) for n in names]
@@ -195,7 +196,7 @@ def read_keypoints(
     ----------
     path : str or path-like
         The file.
-    layout : None, str or object with ``joint_names``, default=None
+    layout : None, str, Layout or object with ``joints``/``joint_names``, default=None
         The joints in file order: a layout name (resolved by
         :func:`skmotion.kinematics.get_layout`), or any object with a
         ``joint_names`` sequence. None takes the names from the file

@@ -152,6 +152,6 @@ def test_a_layout_name_gives_the_layouts_joint_names(tmp_path):
     frames = np.arange(5 * 20 * 3, dtype=float).reshape(5, 20, 3)
     np.save(tmp_path / "k.npy", frames)
     motion = read_keypoints(tmp_path / "k.npy", "kinect_v1", frame_rate=30)
-    assert motion.marker_names == tuple(layout.joint_names)
+    assert motion.marker_names == tuple(layout.joints)
     assert motion.channels.shape == (5, 60)
     np.testing.assert_array_equal(motion.channels, frames.reshape(5, 60))
