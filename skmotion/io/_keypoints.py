@@ -1,8 +1,8 @@
 """Reading keypoint files: joint positions per frame from trackers and pose estimators.
 
-The joint names come from a *layout*: a :class:`~skmotion.kinematics.Layout` or any object with ``joints`` or ``joint_names``
-sequence (the layouts of :mod:`skmotion.preprocessing` have one), or a layout
-name that :func:`skmotion.kinematics.get_layout` resolves.
+The joint names come from a *layout*: a :class:`~skmotion.kinematics.Layout`, any
+object with a ``joints`` or ``joint_names`` sequence, or a layout name that
+:func:`skmotion.kinematics.get_layout` resolves.
 """
 
 import io
