@@ -44,9 +44,10 @@ frame costs the same whatever came before. The per-frame loop is compiled
 import numpy as np
 from sklearn.utils import Bunch
 
+from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decode import _log_normaliser
 from skmotion.tree._online import OnlineKernel
-from skmotion.tree._stream import _check_int, _sum_of_paths
+from skmotion.utils._validation import check_int
 
 __all__ = ["OnlineMotionStream"]
 
@@ -135,9 +136,9 @@ class OnlineMotionStream:
         self.model = model
         tree = self._tree = model.tree_
         self.layer = model.layer_ if layer is None else tree.check_layer(layer)
-        self.lag = _check_int("lag", lag, 0)
-        self.beam = _check_int("beam", model.n_paths if beam is None else beam, 1)
-        self.n_best = min(_check_int("n_best", n_best, 0), int(tree.n_nodes[self.layer]))
+        self.lag = check_int("lag", lag, 0)
+        self.beam = check_int("beam", model.n_paths if beam is None else beam, 1)
+        self.n_best = min(check_int("n_best", n_best, 0), int(tree.n_nodes[self.layer]))
         ancestors = [np.arange(tree.n_nodes[self.layer])]
         for depth in range(self.layer, 0, -1):
             ancestors.insert(0, tree.parents(depth)[ancestors[0]])
@@ -296,7 +297,7 @@ class OnlineMotionStream:
             entries = st["alpha"][depth, : st["n_cand"][depth]]  # (n_cand, n_graphs, n_paths)
             entries = np.moveaxis(entries, 1, 0).reshape(self._n_graphs, -1)
             best = -np.sort(-entries, axis=1)[:, : self._n_paths]
-            out += _sum_of_paths(best) + st["alpha_off"][depth]
+            out += sum_of_paths(best) + st["alpha_off"][depth]
         return out
 
     def state(self):

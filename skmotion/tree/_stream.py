@@ -17,36 +17,15 @@ update decodes the prefix (cost growing with it) or, with ``window``, the last
 profile of ``predict_proba_windows``).
 """
 
-from numbers import Integral
-
 import numpy as np
 from sklearn.utils import Bunch
 
-from skmotion.tree._calibration import log_softmax_rows, per_frame
+from skmotion.tree._calibration import log_softmax_rows, per_frame, sum_of_paths
 from skmotion.tree._decode import beam_decode
 from skmotion.tree._transitions import TransitionGraphs
+from skmotion.utils._validation import check_int
 
 __all__ = ["MotionStream"]
-
-
-def _sum_of_paths(scores):
-    """``log sum exp`` of score lists sorted best first: ``best + log1p(sum exp(rest - best))``."""
-    best = scores[..., 0]
-    if scores.shape[-1] == 1:
-        return best
-    finite = np.isfinite(best)
-    rest = np.exp(scores[..., 1:] - np.where(finite, best, 0.0)[..., None]).sum(axis=-1)
-    return np.where(finite, best + np.log1p(rest), best)
-
-
-def _check_int(name, value, low, allow_none=False):
-    if allow_none and value is None:
-        return None
-    if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
-        raise ValueError(
-            f"{name} must be an int >= {low}{' or None' if allow_none else ''}; got {value!r}."
-        )
-    return int(value)
 
 
 def _side_by_side(graphs, other):
@@ -92,9 +71,9 @@ class MotionStream:
         self.model = model
         tree = self._tree = model.tree_
         self.layer = model.layer_ if layer is None else tree.check_layer(layer)
-        self.lag = _check_int("lag", lag, 0)
-        self.window = _check_int("window", window, 1, allow_none=True)
-        self.n_best = min(_check_int("n_best", n_best, 1), int(tree.n_nodes[self.layer]))
+        self.lag = check_int("lag", lag, 0)
+        self.window = check_int("window", window, 1, allow_none=True)
+        self.n_best = min(check_int("n_best", n_best, 1), int(tree.n_nodes[self.layer]))
         # layer index at each upper layer of every node of the stream's layer
         self._ancestors = [np.arange(tree.n_nodes[self.layer])]
         for depth in range(self.layer, 0, -1):
@@ -191,7 +170,7 @@ class MotionStream:
         The model's calibration: per-frame scores over its ``temperature_``, then a softmax.
         """
         model = self.model
-        per_graph = _sum_of_paths(scores).sum(axis=1)
+        per_graph = sum_of_paths(scores).sum(axis=1)
         if model.graph == "class":
             log_prob = per_graph
         else:
