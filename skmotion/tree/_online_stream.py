@@ -47,6 +47,7 @@ from sklearn.utils import Bunch
 from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decode import _log_normaliser
 from skmotion.tree._online import OnlineKernel
+from skmotion.tree._stream import layer_ancestors
 from skmotion.utils._validation import check_int
 
 __all__ = ["OnlineMotionStream"]
@@ -139,10 +140,8 @@ class OnlineMotionStream:
         self.lag = check_int("lag", lag, 0)
         self.beam = check_int("beam", model.n_paths if beam is None else beam, 1)
         self.n_best = min(check_int("n_best", n_best, 0), int(tree.n_nodes[self.layer]))
-        ancestors = [np.arange(tree.n_nodes[self.layer])]
-        for depth in range(self.layer, 0, -1):
-            ancestors.insert(0, tree.parents(depth)[ancestors[0]])
-        self._ancestors = np.stack(ancestors, axis=1)  # row k: node k's ancestors at 0 .. layer
+        # row k: node k's ancestors at layers 0 .. layer
+        self._ancestors = np.stack(layer_ancestors(tree, self.layer), axis=1)
         n_channels = model.n_features_in_
         self._center = np.ascontiguousarray(model.center_, dtype=np.float64)
         self._scale = np.ascontiguousarray(model.scale_, dtype=np.float64)

@@ -28,6 +28,14 @@ from skmotion.utils._validation import check_int
 __all__ = ["MotionStream"]
 
 
+def layer_ancestors(tree, layer):
+    """Per layer 0 .. ``layer``, the index there of the ancestor of every node of ``layer``."""
+    ancestors = [np.arange(tree.n_nodes[layer])]
+    for depth in range(layer, 0, -1):
+        ancestors.insert(0, tree.parents(depth)[ancestors[0]])
+    return ancestors
+
+
 def _side_by_side(graphs, other):
     """One TransitionGraphs holding ``graphs``' graphs, then ``other``'s."""
     import scipy.sparse as sp
@@ -74,10 +82,7 @@ class MotionStream:
         self.lag = check_int("lag", lag, 0)
         self.window = check_int("window", window, 1, allow_none=True)
         self.n_best = min(check_int("n_best", n_best, 1), int(tree.n_nodes[self.layer]))
-        # layer index at each upper layer of every node of the stream's layer
-        self._ancestors = [np.arange(tree.n_nodes[self.layer])]
-        for depth in range(self.layer, 0, -1):
-            self._ancestors.insert(0, tree.parents(depth)[self._ancestors[0]])
+        self._ancestors = layer_ancestors(tree, self.layer)
         self._guide = model.global_graph_ if model.node_prior == "layer" else None
         # At the classifying layer one decode serves both: the class graphs and, last, the
         # global graph, side by side (each graph's probabilities are computed alone, so
