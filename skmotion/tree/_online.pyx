@@ -32,16 +32,9 @@ import numpy as np
 from libc.math cimport INFINITY, exp, log1p
 from libc.stdlib cimport free, malloc
 
-ctypedef Py_ssize_t intp
+from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
 
-cdef extern from "_emission.h" nogil:
-    void skm_diag_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* prec, double c,
-                      double* out, Py_ssize_t stride)
-    void skm_full_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* factor, const double* shift,
-                      double c, double* out, Py_ssize_t stride, double* y)
-    void skm_lowrank_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* vectors,
-                         const double* w, Py_ssize_t r, double inv_floor, double c, double* out, Py_ssize_t stride,
-                         double* y)
+ctypedef Py_ssize_t intp
 
 
 cdef struct Table:
