@@ -33,6 +33,7 @@ from libc.math cimport INFINITY, exp, log1p
 from libc.stdlib cimport free, malloc
 
 from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
+from skmotion.tree._pairs cimport pair_moves
 
 ctypedef Py_ssize_t intp
 
@@ -64,16 +65,7 @@ cdef struct Layer:
 
 cdef inline const double* _moves(const Table* t, intp src, intp dst) noexcept nogil:
     """``log p(src -> dst)`` in every column of the table, ``n_cols`` contiguous values."""
-    cdef intp lo = t.pair_start[src], hi = t.pair_start[src + 1], end = t.pair_start[src + 1], mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if t.pair_dst[mid] < dst:
-            lo = mid + 1
-        else:
-            hi = mid
-    if lo < end and t.pair_dst[lo] == dst:
-        return t.pair_log + lo * t.n_cols
-    return t.unseen_log + src * t.n_cols
+    return pair_moves(t.pair_start, t.pair_dst, t.pair_log, t.unseen_log, t.n_cols, src, dst)
 
 
 cdef inline void _top(double* pool, intp m, double* out, intp P) noexcept nogil:
