@@ -47,7 +47,7 @@ from sklearn.utils import Bunch
 from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decode import _log_normaliser
 from skmotion.tree._online import OnlineKernel
-from skmotion.tree._stream import layer_ancestors
+from skmotion.tree._stream import layer_ancestors, stream_args
 from skmotion.utils._validation import check_int
 
 __all__ = ["OnlineMotionStream"]
@@ -135,9 +135,8 @@ class OnlineMotionStream:
 
     def __init__(self, model, *, layer=None, lag=0, beam=None, n_best=3):
         self.model = model
-        tree = self._tree = model.tree_
-        self.layer = model.layer_ if layer is None else tree.check_layer(layer)
-        self.lag = check_int("lag", lag, 0)
+        tree, self.layer, self.lag = stream_args(model, layer, lag)
+        self._tree = tree
         self.beam = check_int("beam", model.n_paths if beam is None else beam, 1)
         self.n_best = min(check_int("n_best", n_best, 0), int(tree.n_nodes[self.layer]))
         # row k: node k's ancestors at layers 0 .. layer

@@ -28,6 +28,13 @@ from skmotion.utils._validation import check_int
 __all__ = ["MotionStream"]
 
 
+def stream_args(model, layer, lag):
+    """The model's tree and a stream's checked layer (the model's ``layer_`` by default) and lag."""
+    tree = model.tree_
+    layer = model.layer_ if layer is None else tree.check_layer(layer)
+    return tree, layer, check_int("lag", lag, 0)
+
+
 def layer_ancestors(tree, layer):
     """Per layer 0 .. ``layer``, the index there of the ancestor of every node of ``layer``."""
     ancestors = [np.arange(tree.n_nodes[layer])]
@@ -77,9 +84,8 @@ class MotionStream:
 
     def __init__(self, model, *, layer=None, lag=0, window=None, n_best=3):
         self.model = model
-        tree = self._tree = model.tree_
-        self.layer = model.layer_ if layer is None else tree.check_layer(layer)
-        self.lag = check_int("lag", lag, 0)
+        tree, self.layer, self.lag = stream_args(model, layer, lag)
+        self._tree = tree
         self.window = check_int("window", window, 1, allow_none=True)
         self.n_best = min(check_int("n_best", n_best, 1), int(tree.n_nodes[self.layer]))
         self._ancestors = layer_ancestors(tree, self.layer)
