@@ -47,7 +47,7 @@ from sklearn.utils import Bunch
 from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decode import _log_normaliser
 from skmotion.tree._online import OnlineKernel
-from skmotion.tree._stream import layer_ancestors, stream_args
+from skmotion.tree._stream import layer_ancestors, stream_args, update_frames
 from skmotion.utils._validation import check_int
 
 __all__ = ["OnlineMotionStream"]
@@ -234,13 +234,7 @@ class OnlineMotionStream:
                 "the model was fit again (fit or partial_fit) since this stream was made; "
                 "start a new stream."
             )
-        X = np.asarray(frames, dtype=np.float64)
-        X = X[None] if X.ndim == 1 else X
-        if X.ndim != 2 or X.shape[1] != model.n_features_in_ or not len(X):
-            raise ValueError(
-                f"update takes one frame of {model.n_features_in_} channels or a chunk "
-                f"(n_frames, {model.n_features_in_}); got shape {np.shape(frames)}."
-            )
+        X = update_frames(model, frames)
         return X if X.flags.c_contiguous else np.ascontiguousarray(X)
 
     def _not_finite(self, X, flat):

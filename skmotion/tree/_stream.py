@@ -35,6 +35,18 @@ def stream_args(model, layer, lag):
     return tree, layer, check_int("lag", lag, 0)
 
 
+def update_frames(model, frames):
+    """An update's frame or chunk as a float64 ``(n, n_channels)`` array, its shape checked."""
+    X = np.asarray(frames, dtype=np.float64)
+    X = X[None] if X.ndim == 1 else X
+    if X.ndim != 2 or X.shape[1] != model.n_features_in_ or not len(X):
+        raise ValueError(
+            f"update takes one frame of {model.n_features_in_} channels or a chunk "
+            f"(n_frames, {model.n_features_in_}); got shape {np.shape(frames)}."
+        )
+    return X
+
+
 def layer_ancestors(tree, layer):
     """Per layer 0 .. ``layer``, the index there of the ancestor of every node of ``layer``."""
     ancestors = [np.arange(tree.n_nodes[layer])]
@@ -106,13 +118,7 @@ class MotionStream:
 
     def _append(self, frames):
         model = self.model
-        X = np.asarray(frames, dtype=np.float64)
-        X = X[None] if X.ndim == 1 else X
-        if X.ndim != 2 or X.shape[1] != model.n_features_in_ or not len(X):
-            raise ValueError(
-                f"update takes one frame of {model.n_features_in_} channels or a chunk "
-                f"(n_frames, {model.n_features_in_}); got shape {np.shape(frames)}."
-            )
+        X = update_frames(model, frames)
         if not np.isfinite(X).all():
             row, col = np.argwhere(~np.isfinite(X))[0]
             raise ValueError(
