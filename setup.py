@@ -11,14 +11,22 @@ from setuptools import Extension, setup
 beam = Extension(
     "skmotion.tree._beam",
     ["skmotion/tree/_beam.pyx"],
-    depends=["skmotion/tree/_emission.h"],
+    depends=[
+        "skmotion/tree/_emission.h",
+        "skmotion/tree/_emission.pxd",
+        "skmotion/tree/_pairs.pxd",
+    ],
     extra_compile_args=["-O3", "-fopenmp-simd"],
 )
 # The causal stream's per-frame update (tree/_online_stream.py), the same flags.
 online = Extension(
     "skmotion.tree._online",
     ["skmotion/tree/_online.pyx"],
-    depends=["skmotion/tree/_emission.h"],
+    depends=[
+        "skmotion/tree/_emission.h",
+        "skmotion/tree/_emission.pxd",
+        "skmotion/tree/_pairs.pxd",
+    ],
     extra_compile_args=["-O3", "-fopenmp-simd"],
 )
 setup(ext_modules=cythonize([beam, online]))

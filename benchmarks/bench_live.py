@@ -50,7 +50,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA, interleaved, time_call, write_results  # noqa: E402
+from _common import SHARED_DATA, cmu_windows, interleaved, time_call, write_results  # noqa: E402
 
 # A worktree outside the project folder finds the data through the tests' variable.
 SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
@@ -78,45 +78,6 @@ def synthetic():
         names[train],
         [c for c, m in zip(clips, train) if not m],
         names[~train],
-    )
-
-
-CMU_CLASSES = {
-    "walk": "walk",
-    "run/jog": "run",
-    "jump, balance": "jump",
-    "punch/strike": "punch",
-    "bend over, scoop up, rise, lift arm": "bend",
-    "swordplay": "swordplay",
-    "wash self": "wash",
-}
-
-
-def cmu_windows(window=30, hop=15, train_share=0.6):
-    """CMU subject 02, 30 Hz virtual markers, 1 s windows; train before 60% of each trial."""
-    from skmotion.datasets import load_cmu_asfamc
-    from skmotion.preprocessing import to_markers
-
-    data = load_cmu_asfamc(
-        SHARED_DATA / "cmu-asfamc", index=SHARED_DATA / "cmu-index.csv", subjects=[2]
-    )
-    markers, _ = to_markers(data.motions)
-    step = int(round(data.frame_rate / 30))
-    Xtr, ytr, Xte, yte = [], [], [], []
-    for clip, description in zip((m[::step] for m in markers), data.description):
-        cut = int(train_share * len(clip))
-        for part, X, y in ((clip[:cut], Xtr, ytr), (clip[cut:], Xte, yte)):
-            for start in range(0, len(part) - window + 1, hop):
-                X.append(part[start : start + window])
-                y.append(CMU_CLASSES[description])
-    ytr, yte = np.asarray(ytr), np.asarray(yte)
-    both = np.intersect1d(ytr, yte)
-    keep_tr, keep_te = np.isin(ytr, both), np.isin(yte, both)
-    return (
-        [x for x, k in zip(Xtr, keep_tr) if k],
-        ytr[keep_tr],
-        [x for x, k in zip(Xte, keep_te) if k],
-        yte[keep_te],
     )
 
 

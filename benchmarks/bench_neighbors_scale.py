@@ -83,26 +83,34 @@ def brute_psi_1nn(stored_signatures, queries, k):
     return run
 
 
-def clip_row(n, clips, labels, queries, extra, extra_labels):
+def timed_fit(params, X, y):
+    """The index fitted on ``X, y``, with the fit's wall-clock and CPU seconds."""
     start, cpu = time.perf_counter(), time.process_time()
-    index = IntervalIndexNeighbors(**PARAMS).fit(clips[:n], labels[:n])
-    fit_s, fit_cpu = time.perf_counter() - start, time.process_time() - cpu
-    ours_us, ours = cpu_us(
-        lambda: index.kneighbors(queries, return_distance=False)[:, 0], N_QUERIES
-    )
-    psi_us, reference = cpu_us(brute_psi_1nn(index._ranking, queries, index.k), N_QUERIES)
-    nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(index._tree_features)
-    extractor = index.feature_extractor_
-    knn_us, _ = cpu_us(lambda: nn.kneighbors(extractor.transform(queries)), N_QUERIES)
-    candidates = index.candidates(queries)
+    index = IntervalIndexNeighbors(**params).fit(X, y)
+    return index, time.perf_counter() - start, time.process_time() - cpu
+
+
+def first_neighbor_us(index, queries):
+    """CPU microseconds per query of the index's nearest neighbour, and the neighbours."""
+    return cpu_us(lambda: index.kneighbors(queries, return_distance=False)[:, 0], N_QUERIES)
+
+
+def insert_cpu_ms(index, X, y):
+    """CPU milliseconds of each of ``N_INSERTS`` single insertions of ``X, y`` into the index."""
     insert_ms = []
     for i in range(N_INSERTS):
         t = time.process_time()
-        index.insert(extra[i : i + 1], extra_labels[i : i + 1])
+        index.insert(X[i : i + 1], y[i : i + 1])
         insert_ms.append(1e3 * (time.process_time() - t))
-    return index, {
+    return insert_ms
+
+
+def scale_row(index, n, source, times, agrees, candidates, insert_ms, signatures_bytes):
+    """One results row; ``times`` is (fit_s, fit_cpu, ours_us, psi_us, knn_us)."""
+    fit_s, fit_cpu, ours_us, psi_us, knn_us = times
+    return {
         "stored": n,
-        "input": "clips",
+        "input": source,
         "fit_s": fit_s,
         "fit_cpu_us_per_clip": 1e6 * fit_cpu / n,
         "index_1nn_cpu_us": ours_us,
@@ -110,14 +118,31 @@ def clip_row(n, clips, labels, queries, extra, extra_labels):
         "brute_knn_features_cpu_us": knn_us,
         "speedup_vs_brute_psi": psi_us / ours_us,
         "speedup_vs_brute_knn": knn_us / ours_us,
-        "agrees_with_brute_psi": float(np.mean(ours == reference)),
+        "agrees_with_brute_psi": agrees,
         "candidates_share": float(np.mean([len(c) for c in candidates])) / n,
         "insert_cpu_ms_median": float(np.median(insert_ms)),
         "leaf_entries_per_clip": index.index_.n_stored() / n,
         "tree_MB": index.index_.nbytes() / 1e6,
-        "stored_signatures_MB": sum(a.nbytes for a in index._ranking) / 1e6,
+        "stored_signatures_MB": signatures_bytes / 1e6,
         "peak_rss_MB": peak_rss_mb(),
     }
+
+
+def clip_row(n, clips, labels, queries, extra, extra_labels):
+    index, fit_s, fit_cpu = timed_fit(PARAMS, clips[:n], labels[:n])
+    ours_us, ours = first_neighbor_us(index, queries)
+    psi_us, reference = cpu_us(brute_psi_1nn(index._ranking, queries, index.k), N_QUERIES)
+    nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(index._tree_features)
+    extractor = index.feature_extractor_
+    knn_us, _ = cpu_us(lambda: nn.kneighbors(extractor.transform(queries)), N_QUERIES)
+    candidates = index.candidates(queries)
+    insert_ms = insert_cpu_ms(index, extra, extra_labels)
+    times = (fit_s, fit_cpu, ours_us, psi_us, knn_us)
+    agrees = float(np.mean(ours == reference))
+    signatures_bytes = sum(a.nbytes for a in index._ranking)
+    return index, scale_row(
+        index, n, "clips", times, agrees, candidates, insert_ms, signatures_bytes
+    )
 
 
 def feature_row(n, base, psi_us_base, n_base):
@@ -136,38 +161,17 @@ def feature_row(n, base, psi_us_base, n_base):
         features[rng.choice(n, N_QUERIES, replace=False)]
         + rng.normal(size=(N_QUERIES, features.shape[1])) * noise
     )
-    start, cpu = time.perf_counter(), time.process_time()
-    index = IntervalIndexNeighbors(**{**PARAMS, "similar": "labels"}).fit(features, labels)
-    fit_s, fit_cpu = time.perf_counter() - start, time.process_time() - cpu
-    ours_us, ours = cpu_us(
-        lambda: index.kneighbors(queries, return_distance=False)[:, 0], N_QUERIES
-    )
+    index, fit_s, fit_cpu = timed_fit({**PARAMS, "similar": "labels"}, features, labels)
+    ours_us, ours = first_neighbor_us(index, queries)
     nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(features)
     knn_us, knn = cpu_us(lambda: nn.kneighbors(queries, return_distance=False)[:, 0], N_QUERIES)
-    insert_ms = []
-    for i in range(N_INSERTS):
-        t = time.process_time()
-        index.insert(queries[i : i + 1], labels[i : i + 1])
-        insert_ms.append(1e3 * (time.process_time() - t))
+    insert_ms = insert_cpu_ms(index, queries, labels)
     psi_us = psi_us_base * n / n_base
-    return {
-        "stored": n,
-        "input": "feature vectors (brute psi extrapolated)",
-        "fit_s": fit_s,
-        "fit_cpu_us_per_clip": 1e6 * fit_cpu / n,
-        "index_1nn_cpu_us": ours_us,
-        "brute_psi_cpu_us": psi_us,
-        "brute_knn_features_cpu_us": knn_us,
-        "speedup_vs_brute_psi": psi_us / ours_us,
-        "speedup_vs_brute_knn": knn_us / ours_us,
-        "agrees_with_brute_psi": float(np.mean(ours == knn)),  # here: with brute kNN
-        "candidates_share": float(np.mean([len(c) for c in index.candidates(queries)])) / n,
-        "insert_cpu_ms_median": float(np.median(insert_ms)),
-        "leaf_entries_per_clip": index.index_.n_stored() / n,
-        "tree_MB": index.index_.nbytes() / 1e6,
-        "stored_signatures_MB": index._ranking.nbytes / 1e6,
-        "peak_rss_MB": peak_rss_mb(),
-    }
+    times = (fit_s, fit_cpu, ours_us, psi_us, knn_us)
+    agrees = float(np.mean(ours == knn))  # here: with brute kNN
+    source = "feature vectors (brute psi extrapolated)"
+    candidates = index.candidates(queries)  # after the insertions, as the row reports them
+    return scale_row(index, n, source, times, agrees, candidates, insert_ms, index._ranking.nbytes)
 
 
 def sharded_rows(n=10_000, n_queries=N_QUERIES):

@@ -44,7 +44,15 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import SHARED_DATA, interleaved, time_call, write_results  # noqa: E402
+from _common import (  # noqa: E402
+    CMU_RATE,
+    SHARED_DATA,
+    cmu_markers,
+    interleaved,
+    time_call,
+    write_results,
+)
+from _common import cmu_windows as _common_cmu_windows  # noqa: E402
 from _tree_peers import (  # noqa: E402
     ENCODER_GRID,
     QUICK_ENCODER_GRID,
@@ -131,56 +139,9 @@ def synthetic_positions():
     return pick(train), names[train], pick(~train), names[~train], data.groups[train]
 
 
-CMU_RATE = 30  # Hz, after the markers are computed at the recorded 120 Hz
-CMU_WINDOW, CMU_HOP, CMU_TRAIN_SHARE = 30, 15, 0.6  # frames at 30 Hz: 1 s windows, 0.5 s hop
-# Subject 02's trials by activity (cmu-index.csv descriptions, shortened)
-CMU_CLASSES = {
-    "walk": "walk",
-    "run/jog": "run",
-    "jump, balance": "jump",
-    "punch/strike": "punch",
-    "bend over, scoop up, rise, lift arm": "bend",
-    "swordplay": "swordplay",
-    "wash self": "wash",
-}
-
-
-def cmu_markers(subjects):
-    """Virtual-marker clips (192 channels) of CMU subjects at 30 Hz, with their Bunch (or None)."""
-    from skmotion.datasets import load_cmu_asfamc
-    from skmotion.preprocessing import to_markers
-
-    folder = SHARED_DATA / "cmu-asfamc"
-    if not folder.is_dir():
-        return None, None
-    data = load_cmu_asfamc(folder, index=SHARED_DATA / "cmu-index.csv", subjects=subjects)
-    markers, _ = to_markers(data.motions)  # velocities by central differences at 120 Hz
-    step = int(round(data.frame_rate / CMU_RATE))
-    return [m[::step] for m in markers], data
-
-
 def cmu_windows():
-    """CMU subject 02 cut into windows, split by time inside each trial.
-
-    Each trial (30 Hz virtual markers) is cut at 60% of its frames: training
-    windows lie wholly before the cut, test windows wholly after it, so no
-    window overlaps across train and test (windows overlap only within one side).
-    Windows: 1 s (30 frames), 0.5 s hop. The run/jog trial (02_03, 1.4 s) is
-    too short for a window on both sides and is left out: 6 classes.
-    """
-    clips, data = cmu_markers([2])
-    Xtr, ytr, Xte, yte = [], [], [], []
-    for clip, description in zip(clips, data.description):
-        label = CMU_CLASSES[description]
-        cut = int(CMU_TRAIN_SHARE * len(clip))
-        for part, X, y in ((clip[:cut], Xtr, ytr), (clip[cut:], Xte, yte)):
-            for start in range(0, len(part) - CMU_WINDOW + 1, CMU_HOP):
-                X.append(part[start : start + CMU_WINDOW])
-                y.append(label)
-    ytr, yte = np.asarray(ytr), np.asarray(yte)
-    both = np.intersect1d(ytr, yte)
-    pick = lambda X, y: ([x for x, label in zip(X, y) if label in both], y[np.isin(y, both)])  # noqa: E731
-    return (*pick(Xtr, ytr), *pick(Xte, yte), None)
+    """:func:`_common.cmu_windows`, with no groups (one subject: no subject-wise folds)."""
+    return (*_common_cmu_windows(), None)
 
 
 def cv_for(y, groups, quick=False):

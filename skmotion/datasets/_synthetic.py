@@ -95,6 +95,11 @@ def _smoothstep(x):
 # extra root height in m per frame, root pitch in degrees per frame).
 
 
+# The walk's and the run's parameters of _gait (angles in degrees); a backward walk reuses _WALK.
+_WALK = dict(hip=(4, 22), knee=(5, 55, -0.35), stance=12, ankle=8, arm=16, elbow=(12, 10), lean=2)
+_RUN = dict(hip=(8, 32), knee=(15, 85, -0.5), stance=20, ankle=15, arm=28, elbow=(80, 15), lean=8)
+
+
 def _gait(pose, phi, p, *, hip, knee, stance, ankle, arm, elbow, lean):
     amp = p["amp"]
     for side, shift in (("Left", 0.0), ("Right", np.pi)):
@@ -113,18 +118,7 @@ def _gait(pose, phi, p, *, hip, knee, stance, ankle, arm, elbow, lean):
 def _walk(pose, t, p):
     f = 0.95 * p["tempo"]
     phi = _TWO_PI * f * t + p["phase"]
-    _gait(
-        pose,
-        phi,
-        p,
-        hip=(4, 22),
-        knee=(5, 55, -0.35),
-        stance=12,
-        ankle=8,
-        arm=16,
-        elbow=(12, 10),
-        lean=2,
-    )
+    _gait(pose, phi, p, **_WALK)
     speed = 1.4 * p["scale"] * np.sqrt(p["amp"]) * f * (1 + 0.05 * np.cos(2 * phi))
     return speed, np.zeros_like(t), np.full_like(t, 2.0)
 
@@ -132,18 +126,7 @@ def _walk(pose, t, p):
 def _jog(pose, t, p):
     f = 1.4 * p["tempo"]
     phi = _TWO_PI * f * t + p["phase"]
-    _gait(
-        pose,
-        phi,
-        p,
-        hip=(8, 32),
-        knee=(15, 85, -0.5),
-        stance=20,
-        ankle=15,
-        arm=28,
-        elbow=(80, 15),
-        lean=8,
-    )
+    _gait(pose, phi, p, **_RUN)
     speed = 1.9 * p["scale"] * np.sqrt(p["amp"]) * f * (1 + 0.08 * np.cos(2 * phi))
     flight = 0.05 * p["scale"] * p["amp"] * _bump(2 * phi, np.pi / 2, 0.6)
     return speed, flight, np.full_like(t, 5.0)

@@ -6,7 +6,7 @@ import numpy as np
 from sklearn.utils import Bunch, check_random_state
 
 from skmotion.datasets._humanoid import humanoid_skeleton
-from skmotion.datasets._synthetic import _TWO_PI, _bump, _gait, _Pose
+from skmotion.datasets._synthetic import _TWO_PI, _WALK, _bump, _gait, _Pose
 from skmotion.kinematics import forward_kinematics
 from skmotion.utils._sklearn_compat import Interval, validate_params
 
@@ -48,18 +48,7 @@ def _walk_clip(skeleton, direction, n_frames, frame_rate, p):
         f = 0.9 * p["tempo"] * (1.0 if direction == "forward" else -1.0)
         phi = _TWO_PI * f * t + p["phase"]
         gait = {"amp": p["amp"], "lean": 0.0, "carry": 8.0}
-        _gait(
-            pose,
-            phi,
-            gait,
-            hip=(4, 22),
-            knee=(5, 55, -0.35),
-            stance=12,
-            ankle=8,
-            arm=16,
-            elbow=(12, 10),
-            lean=2,
-        )
+        _gait(pose, phi, gait, **_WALK)
         speed = (
             (1.3 if direction == "forward" else 0.8)
             * p["scale"]

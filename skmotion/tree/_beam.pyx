@@ -37,18 +37,10 @@ import numpy as np
 from libc.math cimport INFINITY, NAN, log
 from libc.stdlib cimport free, malloc
 
-ctypedef Py_ssize_t intp
+from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run, skm_step_all
+from skmotion.tree._pairs cimport pair_moves
 
-cdef extern from "_emission.h" nogil:
-    void skm_diag_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* prec, double c,
-                      double* out, Py_ssize_t stride)
-    void skm_full_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* factor, const double* shift,
-                      double c, double* out, Py_ssize_t stride, double* y)
-    void skm_lowrank_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* vectors,
-                         const double* w, Py_ssize_t r, double inv_floor, double c, double* out, Py_ssize_t stride,
-                         double* y)
-    void skm_step_all(const double* prev, const double** rows, const double* emit, Py_ssize_t n_cand, Py_ssize_t P,
-                      double* cur)
+ctypedef Py_ssize_t intp
 
 #: What a call computes per problem; see :func:`decode_searches`.
 MODES = ("best", "kbest", "prune")
@@ -118,16 +110,7 @@ cdef inline const double* _moves_of(const Table* t, intp src, intp dst) noexcept
         return t.dense + ((t.k if src < 0 else src) * (t.k + 1) + (t.k if dst < 0 else dst)) * t.n_graphs
     if src < 0 or dst < 0:
         return t.unseen_log + t.k * t.n_graphs
-    cdef intp lo = t.pair_start[src], hi = t.pair_start[src + 1], end = t.pair_start[src + 1], mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if t.pair_dst[mid] < dst:
-            lo = mid + 1
-        else:
-            hi = mid
-    if lo < end and t.pair_dst[lo] == dst:
-        return t.pair_log + lo * t.n_graphs
-    return t.unseen_log + src * t.n_graphs
+    return pair_moves(t.pair_start, t.pair_dst, t.pair_log, t.unseen_log, t.n_graphs, src, dst)
 
 
 cdef bint _same_row(const intp* a, const intp* b, intp n) noexcept nogil:

@@ -11,11 +11,30 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 from scipy.special import log_softmax, logsumexp
 
-__all__ = ["fit_temperature", "log_softmax_rows", "mixture_log_density", "per_frame"]
+__all__ = [
+    "fit_temperature",
+    "log_softmax_rows",
+    "mixture_log_density",
+    "per_frame",
+    "sum_of_paths",
+]
 
 # Log-temperatures searched (bounded, so one class's certainty never becomes exactly 1 or 0
 # through the temperature alone): 1e-4 to 1e4 times the per-frame score scale.
 _LOG_T_BOUNDS = (np.log(1e-4), np.log(1e4))
+
+
+def sum_of_paths(scores):
+    """``log sum exp`` over the last axis of lists sorted best first (as the decoder returns them).
+
+    The best is the maximum, so no search for it: ``best + log1p(sum exp(rest - best))``.
+    """
+    best = scores[..., 0]
+    if scores.shape[-1] == 1:
+        return best
+    finite = np.isfinite(best)
+    rest = np.exp(scores[..., 1:] - np.where(finite, best, 0.0)[..., None]).sum(axis=-1)
+    return np.where(finite, best + np.log1p(rest), best)
 
 
 def log_softmax_rows(scores):

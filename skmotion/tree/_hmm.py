@@ -16,6 +16,7 @@ from skmotion.tree._calibration import (
     log_softmax_rows,
     mixture_log_density,
     per_frame,
+    sum_of_paths,
 )
 from skmotion.tree._decode import NODE_PRIORS
 from skmotion.tree._gaussian import COVARIANCE_TYPES
@@ -29,19 +30,6 @@ from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 from skmotion.utils._validation import check_int
 
 __all__ = ["MotionTreeHMM"]
-
-
-def _sum_of_paths(scores):
-    """``log sum exp`` over the last axis of lists sorted best first (as the decoder returns them).
-
-    The best is the maximum, so no search for it: ``best + log1p(sum exp(rest - best))``.
-    """
-    best = scores[..., 0]
-    if scores.shape[-1] == 1:
-        return best
-    finite = np.isfinite(best)
-    rest = np.exp(scores[..., 1:] - np.where(finite, best, 0.0)[..., None]).sum(axis=-1)
-    return np.where(finite, best + np.log1p(rest), best)
 
 
 _check_count = check_int  # the one integer check, skmotion.utils._validation
@@ -459,7 +447,7 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             paths=False,
             guide=guide,
         )
-        per_graph = _sum_of_paths(scores).sum(axis=2)
+        per_graph = sum_of_paths(scores).sum(axis=2)
         if self.graph == "class":
             return per_graph
         out = np.full((len(clips), len(self.classes_)), -np.inf)

@@ -32,16 +32,10 @@ import numpy as np
 from libc.math cimport INFINITY, exp, log1p
 from libc.stdlib cimport free, malloc
 
-ctypedef Py_ssize_t intp
+from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
+from skmotion.tree._pairs cimport pair_moves
 
-cdef extern from "_emission.h" nogil:
-    void skm_diag_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* prec, double c,
-                      double* out, Py_ssize_t stride)
-    void skm_full_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* factor, const double* shift,
-                      double c, double* out, Py_ssize_t stride, double* y)
-    void skm_lowrank_run(const double* x, Py_ssize_t n, Py_ssize_t d, const double* mu, const double* vectors,
-                         const double* w, Py_ssize_t r, double inv_floor, double c, double* out, Py_ssize_t stride,
-                         double* y)
+ctypedef Py_ssize_t intp
 
 
 cdef struct Table:
@@ -71,16 +65,7 @@ cdef struct Layer:
 
 cdef inline const double* _moves(const Table* t, intp src, intp dst) noexcept nogil:
     """``log p(src -> dst)`` in every column of the table, ``n_cols`` contiguous values."""
-    cdef intp lo = t.pair_start[src], hi = t.pair_start[src + 1], end = t.pair_start[src + 1], mid
-    while lo < hi:
-        mid = (lo + hi) >> 1
-        if t.pair_dst[mid] < dst:
-            lo = mid + 1
-        else:
-            hi = mid
-    if lo < end and t.pair_dst[lo] == dst:
-        return t.pair_log + lo * t.n_cols
-    return t.unseen_log + src * t.n_cols
+    return pair_moves(t.pair_start, t.pair_dst, t.pair_log, t.unseen_log, t.n_cols, src, dst)
 
 
 cdef inline void _top(double* pool, intp m, double* out, intp P) noexcept nogil:

@@ -44,9 +44,11 @@ frame costs the same whatever came before. The per-frame loop is compiled
 import numpy as np
 from sklearn.utils import Bunch
 
+from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decode import _log_normaliser
 from skmotion.tree._online import OnlineKernel
-from skmotion.tree._stream import _check_int, _sum_of_paths
+from skmotion.tree._stream import layer_ancestors, stream_args, update_frames
+from skmotion.utils._validation import check_int
 
 __all__ = ["OnlineMotionStream"]
 
@@ -133,15 +135,12 @@ class OnlineMotionStream:
 
     def __init__(self, model, *, layer=None, lag=0, beam=None, n_best=3):
         self.model = model
-        tree = self._tree = model.tree_
-        self.layer = model.layer_ if layer is None else tree.check_layer(layer)
-        self.lag = _check_int("lag", lag, 0)
-        self.beam = _check_int("beam", model.n_paths if beam is None else beam, 1)
-        self.n_best = min(_check_int("n_best", n_best, 0), int(tree.n_nodes[self.layer]))
-        ancestors = [np.arange(tree.n_nodes[self.layer])]
-        for depth in range(self.layer, 0, -1):
-            ancestors.insert(0, tree.parents(depth)[ancestors[0]])
-        self._ancestors = np.stack(ancestors, axis=1)  # row k: node k's ancestors at 0 .. layer
+        tree, self.layer, self.lag = stream_args(model, layer, lag)
+        self._tree = tree
+        self.beam = check_int("beam", model.n_paths if beam is None else beam, 1)
+        self.n_best = min(check_int("n_best", n_best, 0), int(tree.n_nodes[self.layer]))
+        # row k: node k's ancestors at layers 0 .. layer
+        self._ancestors = np.stack(layer_ancestors(tree, self.layer), axis=1)
         n_channels = model.n_features_in_
         self._center = np.ascontiguousarray(model.center_, dtype=np.float64)
         self._scale = np.ascontiguousarray(model.scale_, dtype=np.float64)
@@ -235,13 +234,7 @@ class OnlineMotionStream:
                 "the model was fit again (fit or partial_fit) since this stream was made; "
                 "start a new stream."
             )
-        X = np.asarray(frames, dtype=np.float64)
-        X = X[None] if X.ndim == 1 else X
-        if X.ndim != 2 or X.shape[1] != model.n_features_in_ or not len(X):
-            raise ValueError(
-                f"update takes one frame of {model.n_features_in_} channels or a chunk "
-                f"(n_frames, {model.n_features_in_}); got shape {np.shape(frames)}."
-            )
+        X = update_frames(model, frames)
         return X if X.flags.c_contiguous else np.ascontiguousarray(X)
 
     def _not_finite(self, X, flat):
@@ -296,7 +289,7 @@ class OnlineMotionStream:
             entries = st["alpha"][depth, : st["n_cand"][depth]]  # (n_cand, n_graphs, n_paths)
             entries = np.moveaxis(entries, 1, 0).reshape(self._n_graphs, -1)
             best = -np.sort(-entries, axis=1)[:, : self._n_paths]
-            out += _sum_of_paths(best) + st["alpha_off"][depth]
+            out += sum_of_paths(best) + st["alpha_off"][depth]
         return out
 
     def state(self):

@@ -17,36 +17,42 @@ update decodes the prefix (cost growing with it) or, with ``window``, the last
 profile of ``predict_proba_windows``).
 """
 
-from numbers import Integral
-
 import numpy as np
 from sklearn.utils import Bunch
 
-from skmotion.tree._calibration import log_softmax_rows, per_frame
+from skmotion.tree._calibration import log_softmax_rows, per_frame, sum_of_paths
 from skmotion.tree._decode import beam_decode
 from skmotion.tree._transitions import TransitionGraphs
+from skmotion.utils._validation import check_int
 
 __all__ = ["MotionStream"]
 
 
-def _sum_of_paths(scores):
-    """``log sum exp`` of score lists sorted best first: ``best + log1p(sum exp(rest - best))``."""
-    best = scores[..., 0]
-    if scores.shape[-1] == 1:
-        return best
-    finite = np.isfinite(best)
-    rest = np.exp(scores[..., 1:] - np.where(finite, best, 0.0)[..., None]).sum(axis=-1)
-    return np.where(finite, best + np.log1p(rest), best)
+def stream_args(model, layer, lag):
+    """The model's tree and a stream's checked layer (the model's ``layer_`` by default) and lag."""
+    tree = model.tree_
+    layer = model.layer_ if layer is None else tree.check_layer(layer)
+    return tree, layer, check_int("lag", lag, 0)
 
 
-def _check_int(name, value, low, allow_none=False):
-    if allow_none and value is None:
-        return None
-    if not isinstance(value, Integral) or isinstance(value, bool) or value < low:
+def update_frames(model, frames):
+    """An update's frame or chunk as a float64 ``(n, n_channels)`` array, its shape checked."""
+    X = np.asarray(frames, dtype=np.float64)
+    X = X[None] if X.ndim == 1 else X
+    if X.ndim != 2 or X.shape[1] != model.n_features_in_ or not len(X):
         raise ValueError(
-            f"{name} must be an int >= {low}{' or None' if allow_none else ''}; got {value!r}."
+            f"update takes one frame of {model.n_features_in_} channels or a chunk "
+            f"(n_frames, {model.n_features_in_}); got shape {np.shape(frames)}."
         )
-    return int(value)
+    return X
+
+
+def layer_ancestors(tree, layer):
+    """Per layer 0 .. ``layer``, the index there of the ancestor of every node of ``layer``."""
+    ancestors = [np.arange(tree.n_nodes[layer])]
+    for depth in range(layer, 0, -1):
+        ancestors.insert(0, tree.parents(depth)[ancestors[0]])
+    return ancestors
 
 
 def _side_by_side(graphs, other):
@@ -90,15 +96,11 @@ class MotionStream:
 
     def __init__(self, model, *, layer=None, lag=0, window=None, n_best=3):
         self.model = model
-        tree = self._tree = model.tree_
-        self.layer = model.layer_ if layer is None else tree.check_layer(layer)
-        self.lag = _check_int("lag", lag, 0)
-        self.window = _check_int("window", window, 1, allow_none=True)
-        self.n_best = min(_check_int("n_best", n_best, 1), int(tree.n_nodes[self.layer]))
-        # layer index at each upper layer of every node of the stream's layer
-        self._ancestors = [np.arange(tree.n_nodes[self.layer])]
-        for depth in range(self.layer, 0, -1):
-            self._ancestors.insert(0, tree.parents(depth)[self._ancestors[0]])
+        tree, self.layer, self.lag = stream_args(model, layer, lag)
+        self._tree = tree
+        self.window = check_int("window", window, 1, allow_none=True)
+        self.n_best = min(check_int("n_best", n_best, 1), int(tree.n_nodes[self.layer]))
+        self._ancestors = layer_ancestors(tree, self.layer)
         self._guide = model.global_graph_ if model.node_prior == "layer" else None
         # At the classifying layer one decode serves both: the class graphs and, last, the
         # global graph, side by side (each graph's probabilities are computed alone, so
@@ -116,13 +118,7 @@ class MotionStream:
 
     def _append(self, frames):
         model = self.model
-        X = np.asarray(frames, dtype=np.float64)
-        X = X[None] if X.ndim == 1 else X
-        if X.ndim != 2 or X.shape[1] != model.n_features_in_ or not len(X):
-            raise ValueError(
-                f"update takes one frame of {model.n_features_in_} channels or a chunk "
-                f"(n_frames, {model.n_features_in_}); got shape {np.shape(frames)}."
-            )
+        X = update_frames(model, frames)
         if not np.isfinite(X).all():
             row, col = np.argwhere(~np.isfinite(X))[0]
             raise ValueError(
@@ -191,7 +187,7 @@ class MotionStream:
         The model's calibration: per-frame scores over its ``temperature_``, then a softmax.
         """
         model = self.model
-        per_graph = _sum_of_paths(scores).sum(axis=1)
+        per_graph = sum_of_paths(scores).sum(axis=1)
         if model.graph == "class":
             log_prob = per_graph
         else:

@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTreeHMM, exhaustive_viterbi
+from skmotion.tree._calibration import sum_of_paths as _sum_of_paths
 from skmotion.tree._decode import _log_normaliser
-from skmotion.tree._stream import _sum_of_paths
 
 
 def _data():
