@@ -35,7 +35,7 @@ import pandas as pd
 from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import GroupKFold, cross_val_score
 from sklearn.pipeline import make_pipeline
-from sklearn.preprocessing import FunctionTransformer, StandardScaler
+from sklearn.preprocessing import FunctionTransformer
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA, write_results  # noqa: E402
@@ -45,31 +45,23 @@ from skmotion.io import Motion, as_motions, read_amc, read_asf  # noqa: E402
 from skmotion.preprocessing import (  # noqa: E402
     LAYOUTS,
     FillGaps,
-    FlattenClips,
-    ResampleClips,
     VirtualMarkerTransform,
     body_frame_features,
     get_layout,
 )
+from skmotion.tree import MotionTreeEncoder  # noqa: E402
 
 CM_PER_UNIT = 2.54 / 0.45  # CMU ASF lengths are in 1/0.45 inch
 BINS = ((1, 2), (3, 5), (6, 10), (11, 20), (21, 30))
 
 
 def recognition_pipeline(first):
-    """The recogniser compared on positions and on angles.
+    """The recogniser compared on positions and on angles: the recommended one.
 
-    The recommended recogniser is a ``MotionTreeEncoder`` pipeline (built on
-    another branch); until it is merged this is a resample-flatten-logistic
-    pipeline. Swap the steps after ``first`` for the encoder pipeline here.
+    ``first`` (the virtual markers of the input), then ``MotionTreeEncoder()`` and a
+    ``LogisticRegression``, every parameter at its default (see docs/motion-database.md).
     """
-    return make_pipeline(
-        first,
-        ResampleClips(n_frames=32),
-        FlattenClips(),
-        StandardScaler(),
-        LogisticRegression(max_iter=2000),
-    )
+    return make_pipeline(first, MotionTreeEncoder(), LogisticRegression(max_iter=5000))
 
 
 def cut_gaps(clip, dim, rng, fraction):
@@ -341,6 +333,7 @@ def main(argv=None):
     parser.add_argument("--before-src", help="a source tree of an older skmotion, for memory")
     parser.add_argument("--figure", action="store_true", help="write docs/images/positions_*.png")
     parser.add_argument("--only-speed", action="store_true", help="only the timings")
+    parser.add_argument("--only-recognition", action="store_true", help="only positions vs angles")
     args = parser.parse_args(argv)
     data = Path(args.data)
     if not (data / "cmu-asfamc").is_dir():
@@ -353,6 +346,10 @@ def main(argv=None):
     note = f"{len(motions)} CMU trials (subjects 01-03), {n_frames} frames at 120 Hz."
     if args.only_speed:
         write_results("positions_speed", speed(motions, 100_000), notes="10^5-frame clips.")
+        return
+    if args.only_recognition:
+        rows = recognition_synthetic() + recognition_cmu(motions)
+        write_results("positions_recognition", rows, notes=recognition_pipeline.__doc__.strip())
         return
     fill_rows = fill_errors(motions, rng)
     write_results("positions_fill", fill_rows, notes=note)

@@ -70,7 +70,7 @@ def test_demo_on_a_folder_of_files(tmp_path, capsys):
     out_dir = tmp_path.parent / f"{tmp_path.name}-out"
     assert main(["demo", "--data", str(tmp_path), "--frame-rate", "20", "--out", str(out_dir)]) == 0
     out = capsys.readouterr().out
-    assert f"{tmp_path}: 6 clips (6 BVH, 0 ASF/AMC)" in out
+    assert f"{tmp_path}: 6 clips (6 BVH)" in out
     assert "recorded at 60 Hz" in out and "resampled to 20 Hz" in out
     assert "channels: 66 joint angles" in out
     # no index: labels from a keyword in the file name, else the folder (names 00_01 ... have none)

@@ -114,6 +114,8 @@ def _marker_clips(context):
 
 
 def run(context):
+    if getattr(context, "marker_clips", False) is None:
+        return ["not run: the clips have no virtual markers (the markers section says why)"]
     if getattr(context, "data_folder", None):
         skipped = [
             "repeated-motion benchmark (make_repeated_motions): skipped, it needs every motion "

@@ -27,13 +27,14 @@ TITLE = "Virtual markers: positions and velocities in the body frame"
 def _markers(context):
     """Body-frame marker clips, their names and how they were placed (or why they cannot be)."""
     data = context.data
-    if data.get("skeleton") is None and "layout" in data and data.get("motions"):
+    motions = data.get("motions")
+    if motions and all(m.skeleton is None for m in motions):  # joint positions, no skeleton
         if data.layout is None:
             return None, None, "position clips whose joints match no named layout"
         transform = VirtualMarkerTransform(layout=data.layout, frame_rate=data.frame_rate)
         clips = transform.fit_transform(data.clips)
         return clips, list(transform.marker_names_), f"the {data.layout.name} layout"
-    motions = data.get("motions") or as_motions(data.clips, data.skeletons, data.frame_rate)
+    motions = motions or as_motions(data.clips, data.skeletons, data.frame_rate)
     presets = Counter(detect_marker_preset(m.skeleton) for m in motions)
     marker_clips, names = to_markers(motions)
     clips = [to_rate(c, m.frame_rate, data.frame_rate) for c, m in zip(marker_clips, motions)]

@@ -39,6 +39,8 @@ def run(context):
     # Virtual markers (left by the markers section): every skeleton in one feature space, and the
     # root's travel and heading removed, which say where a subject walked, not how it moved.
     clips = context.marker_clips
+    if clips is None:
+        return ["not run: the clips have no virtual markers (the markers section says why)"]
     names = np.asarray(data.target_names)[data.target]
     evaluation = evaluation_of(context)
     if evaluation.kind is None:
