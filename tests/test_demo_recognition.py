@@ -31,6 +31,6 @@ def test_recognition_section(capsys):
 def test_plots_are_saved(tmp_path):
     pytest.importorskip("matplotlib")
     lines = []
-    run_demo(lines.append, sections=SECTIONS, plot_dir=tmp_path)
+    run_demo(lines.append, sections=SECTIONS, out=tmp_path)
     assert (tmp_path / "motion_tree_layers.png").stat().st_size > 0
     assert any(str(tmp_path) in line for line in lines)

@@ -40,7 +40,7 @@ def run_demo(write, *, random_state=0, sections=SECTIONS, out=None, verbose=0, *
         Modules of the sections to run.
     out : str or path-like, default=None
         The output folder for the figures and ``report.html`` (text and figures in one
-        file); None writes nothing. ``plot_dir`` is accepted as its old name.
+        file); None writes nothing.
     verbose : int, default=0
         1 reports each section's start and time on standard error.
     **options
@@ -52,8 +52,6 @@ def run_demo(write, *, random_state=0, sections=SECTIONS, out=None, verbose=0, *
         What the sections computed (the data, fitted models, scores); ``report`` holds
         (title, lines, figures) per section and ``report_path`` the HTML file.
     """
-    out = out if out is not None else options.pop("plot_dir", None)
-    options.pop("plot_dir", None)
     context = SimpleNamespace(
         random_state=random_state, out=out, verbose=verbose, figures=[], report=[], **options
     )
