@@ -29,4 +29,10 @@ online = Extension(
     ],
     extra_compile_args=["-O3", "-fopenmp-simd"],
 )
-setup(ext_modules=cythonize([beam, online]))
+# The body frame of point trajectories in one pass over the frames (preprocessing/_position_frame.py).
+position_frame = Extension(
+    "skmotion.preprocessing._position_frame_loops",
+    ["skmotion/preprocessing/_position_frame_loops.pyx"],
+    extra_compile_args=["-O3"],
+)
+setup(ext_modules=cythonize([beam, online, position_frame]))
