@@ -29,7 +29,7 @@ online = Extension(
     ],
     extra_compile_args=["-O3", "-fopenmp-simd"],
 )
-# The body frame of point trajectories in one pass over the frames (preprocessing/_position_frame.py).
+# The body frame of point trajectories, one pass over the frames (preprocessing/_position_frame).
 position_frame = Extension(
     "skmotion.preprocessing._position_frame_loops",
     ["skmotion/preprocessing/_position_frame_loops.pyx"],

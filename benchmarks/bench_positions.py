@@ -8,20 +8,24 @@ the values of each clip are removed in gaps of 1-30 frames and filled again:
   and the peer ``pandas.DataFrame.interpolate`` (linear, same ``limit``), error
   in cm against the removed true values, by gap length;
 - frames per second of ``VirtualMarkerTransform(layout=...)`` without and with
-  velocities, against the previous implementation (``body_frame_features``, one
-  root marker, run in the same process), and of gap filling;
+  velocities, against the previous implementations run in the same process
+  (``body_frame_features``, one root marker; and, with ``--before-src``, the
+  ``position_frame_features`` of that source tree, e.g. the numpy one of commit
+  467af5c), and of gap filling;
 - peak memory (VmHWM of a fresh process) of ``VirtualMarkerTransform`` on one
   10^5-frame joint-angle clip;
 - recognition from positions vs from joint angles of the same clips (synthetic
   subjects, and windows of CMU trials), through :func:`recognition_pipeline`.
 
 Run ``python benchmarks/bench_positions.py`` (quick: 4 trials per subject, at most
-2400 frames each) or ``--full``; ``--data`` points at the shared data folder.
+2400 frames each) or ``--full``; ``--data`` points at the shared data folder;
+``--only-speed`` runs the timings alone (set ``OPENBLAS_NUM_THREADS=1`` for one core).
 Timings are CPU seconds of this process (``time.process_time``) as well as wall
 seconds: the machine may be shared.
 """
 
 import argparse
+import importlib.util
 import json
 import os
 import subprocess
@@ -161,7 +165,32 @@ def _rates(steps, rounds=5):
     return {name: (float(np.median(cpu[name])), float(np.median(wall[name]))) for name in steps}
 
 
-def speed(motions, n_frames):
+def _previous_frame_features(src):
+    """``position_frame_features`` of an older source tree (its module needs only numpy)."""
+    path = Path(src) / "skmotion" / "preprocessing" / "_position_frame.py"
+    spec = importlib.util.spec_from_file_location("previous_position_frame", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.position_frame_features
+
+
+def _previous_steps(features, vmt, clip):
+    """The previous body frame with ``vmt``'s fitted roles, without and with velocities."""
+    layout = vmt.layout_
+    points = clip.reshape(len(clip), layout.n_joints, layout.dim)
+    kw = dict(root=vmt.root_index_, lefts=vmt.facing_indices_[0], rights=vmt.facing_indices_[1])
+    kw.update(size_chain=vmt.size_indices_, up=layout.up, frame_rate=120.0)
+    return {
+        f"previous position_frame_features, velocities={v}": (
+            partial(features, points, velocities=v, outputs=vmt._outputs, **kw),
+            len(clip),
+        )
+        for v in (False, True)
+    }
+
+
+def speed(motions, n_frames, before_src=None):
+    before = None if before_src is None else _previous_frame_features(before_src)
     skeleton, channels = motions[0][1].skeleton, motions[0][1].channels
     reps = -(-n_frames // len(channels))
     rows = []
@@ -180,6 +209,8 @@ def speed(motions, n_frames):
                 partial(vmt.transform, [clip]),
                 n_frames,
             )
+        if before is not None:
+            steps.update(_previous_steps(before, vmt, clip))
         if layout.dim == 3:
             points = clip.reshape(n_frames, layout.n_joints, 3)
             left, right = layout.index(layout.left_hip), layout.index(layout.right_hip)
@@ -330,7 +361,9 @@ def main(argv=None):
     parser.add_argument("--full", action="store_true", help="every trial, whole length")
     default = os.environ.get("SKMOTION_SHARED_DATA", str(SHARED_DATA))
     parser.add_argument("--data", default=default, help="the shared data folder")
-    parser.add_argument("--before-src", help="a source tree of an older skmotion, for memory")
+    parser.add_argument(
+        "--before-src", help="a source tree of an older skmotion, for memory and the body frame"
+    )
     parser.add_argument("--figure", action="store_true", help="write docs/images/positions_*.png")
     parser.add_argument("--only-speed", action="store_true", help="only the timings")
     parser.add_argument("--only-recognition", action="store_true", help="only positions vs angles")
@@ -345,7 +378,8 @@ def main(argv=None):
     rng = np.random.default_rng(0)
     note = f"{len(motions)} CMU trials (subjects 01-03), {n_frames} frames at 120 Hz."
     if args.only_speed:
-        write_results("positions_speed", speed(motions, 100_000), notes="10^5-frame clips.")
+        rows = speed(motions, 100_000, args.before_src)
+        write_results("positions_speed", rows, notes="10^5-frame clips.")
         return
     if args.only_recognition:
         rows = recognition_synthetic() + recognition_cmu(motions)
@@ -355,7 +389,8 @@ def main(argv=None):
     write_results("positions_fill", fill_rows, notes=note)
     if args.figure:
         figure(fill_rows, Path(__file__).resolve().parents[1] / "docs" / "images")
-    write_results("positions_speed", speed(motions, 100_000), notes="10^5-frame clips.")
+    rows = speed(motions, 100_000, args.before_src)
+    write_results("positions_speed", rows, notes="10^5-frame clips.")
     mem = [memory(Path(__file__).resolve().parents[1])]
     if args.before_src:
         mem.insert(0, memory(Path(args.before_src)))
