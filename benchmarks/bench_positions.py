@@ -200,7 +200,7 @@ def speed(motions, n_frames, before_src=None):
         if LAYOUTS[name].dim == 2:  # image keypoints: drop depth (a projection does not matter)
             layout = LAYOUTS[name]
             clip = clip.reshape(n_frames, -1, 3)[..., :2].reshape(n_frames, -1)
-        steps = {}
+        steps, fitted = {}, {}
         for velocities in (False, True):
             vmt = VirtualMarkerTransform(
                 layout=layout, markers="all", velocities=velocities, frame_rate=120.0
@@ -209,6 +209,12 @@ def speed(motions, n_frames, before_src=None):
                 partial(vmt.transform, [clip]),
                 n_frames,
             )
+            fitted[velocities] = vmt
+        short = [clip[i : i + 100] for i in range(0, n_frames, 100)]  # 1000 windows
+        steps["layout transform, 100-frame clips, velocities=False"] = (
+            partial(fitted[False].transform, short),
+            n_frames,
+        )
         if before is not None:
             steps.update(_previous_steps(before, vmt, clip))
         if layout.dim == 3:
