@@ -148,10 +148,13 @@ def position_frame_features(
     points = np.ascontiguousarray(points)
     axis = "xyz".index(up[-1])
     flip = _flip(dim, up)
-    size = 1.0 if size_chain is None else _safe_size(points, size_chain)
+    if size_chain is not None and len(size_chain) < 2:
+        raise ValueError(f"the size chain needs two points or more, got {list(size_chain)}")
+    # One pass for the size chain and the floor (the lowest point over the clip).
+    size, low, high = _size_and_heights(points, () if size_chain is None else size_chain, axis)
+    size = 1.0 if size_chain is None else size
     if isinstance(floor, str):
-        heights = points[..., axis]
-        level = float(np.min(heights) if flip[axis] > 0 else -np.max(heights))
+        level = low if flip[axis] > 0 else -high
     else:
         level = float(floor) * flip[axis]
     outputs = np.arange(n_points) if outputs is None else outputs
@@ -167,7 +170,7 @@ def position_frame_features(
             stop = min(start + chunk, n_frames)
             args = (root, outputs, sign / size, flip[1] / size, level / size, velocities, rate)
             _loops.frames_2d(points, out, start, stop, *args)
-        return out.reshape(n_frames, -1)
+        return out.reshape(n_frames, out.shape[1] * out.shape[2])
     for start in range(0, n_frames, chunk):
         stop = min(start + chunk, n_frames)
         args = (root, lefts, rights, outputs, axis, flip, level, size, _TINY, velocities, rate)
@@ -177,15 +180,15 @@ def position_frame_features(
                 f"the left and right facing markers are vertically aligned at frame {flat}: "
                 "no facing direction on the floor"
             )
-    return out.reshape(n_frames, -1)
+    return out.reshape(n_frames, out.shape[1] * out.shape[2])
 
 
-def _point_indices(n_points, **groups):
+def _point_indices(n_points, allow_empty=False, **groups):
     """Each group of point indices as an intp array, checked: the compiled loops do not."""
     arrays = {what: np.asarray(group, dtype=np.intp).reshape(-1) for what, group in groups.items()}
     for what, array in arrays.items():
         values = array.tolist()  # min/max of a short list: far cheaper than numpy's
-        if not values and what != "outputs":
+        if not values and not allow_empty and what != "outputs":
             raise ValueError(f"{what} names no point")
         if values and not (0 <= min(values) and max(values) < n_points):
             raise IndexError(f"{what} {values} out of range for {n_points} points")
@@ -216,16 +219,17 @@ def _row_medians(values):
     return (values[:, half - 1] + values[:, half]) / 2.0
 
 
-def _safe_size(points, chain):
-    """Body size along a chain, computed on power-of-two scaled points (no overflow)."""
-    (chain,) = _point_indices(points.shape[1], size_chain=chain)
-    if len(chain) < 2:
-        raise ValueError(f"the size chain needs two points or more, got {chain.tolist()}")
-    steps = np.empty((len(chain) - 1, len(points)))
-    peak = _loops.chain_steps(points, chain, 1.0, steps)
+def _size_and_heights(points, chain, axis):
+    """Body size along a chain (nan for an empty chain), computed on power-of-two scaled
+    points (no overflow); and the lowest and highest coordinate ``axis`` over the clip."""
+    (chain,) = _point_indices(points.shape[1], size_chain=chain, allow_empty=True)
+    steps = np.empty((max(len(chain) - 1, 0), len(points)))
+    peak, low, high = _loops.chain_steps(points, chain, 1.0, steps, axis)
+    if not len(chain):
+        return np.nan, low, high
     scale = _power_of_two_scale(peak)
     if scale != 1.0:
-        _loops.chain_steps(points, chain, scale, steps)
+        _loops.chain_steps(points, chain, scale, steps, axis)
     size = float(_row_medians(steps).sum()) if len(points) else np.nan
     if not size > _TINY * peak * scale:
         what = "0" if size == 0 else f"{size / scale:.3g}"
@@ -234,4 +238,4 @@ def _safe_size(points, chain):
             f"{peak:.3g}: the body is lost in floating-point rounding "
             "(or the size joints coincide); centre the clip or check the size joints"
         )
-    return size / scale
+    return size / scale, low, high

@@ -13,6 +13,8 @@ arithmetic is in float64; ``out`` is the float64 ``(n_frames, n_out, k)``
 output. Every loop releases the GIL (clips run in parallel threads).
 """
 
+import numpy as np
+
 from libc.math cimport fabs, hypot, sqrt
 
 ctypedef Py_ssize_t intp
@@ -23,18 +25,30 @@ ctypedef fused real:
 
 
 def chain_steps(const real[:, :, ::1] points, const intp[::1] chain, double scale,
-                double[:, ::1] steps):
+                double[:, ::1] steps, intp axis):
     """Fill ``steps[k, f]``, the length of step ``k`` of the chain at frame ``f``.
 
     The points are multiplied by ``scale`` (a power of two, exact) first. Returns
-    the largest ``|coordinate|`` of the chain points (unscaled).
+    the largest ``|coordinate|`` of the chain points (unscaled), and the lowest and
+    highest coordinate ``axis`` of all points over the clip (the floor), read in
+    the same pass.
     """
-    cdef intp n = points.shape[0], dim = points.shape[2], n_steps = chain.shape[0] - 1
+    cdef intp n = points.shape[0], n_points = points.shape[1], dim = points.shape[2]
+    cdef intp n_steps = max(chain.shape[0] - 1, 0)
     cdef intp f, k, d, a, b
-    cdef double diff, total, peak = 0.0
+    cdef double diff, total, value, peak = 0.0, low = 0.0, high = 0.0
+    # one running minimum and maximum per point: independent chains the CPU overlaps
+    cdef double[::1] lows = np.zeros(n_points), highs = np.zeros(n_points)
+    if n:
+        lows = np.array(np.asarray(points)[0, :, axis], dtype=np.float64)
+        highs = lows.copy()
     with nogil:
         for f in range(n):
-            for k in range(n_steps + 1):
+            for k in range(n_points):
+                value = points[f, k, axis]
+                lows[k] = min(lows[k], value)
+                highs[k] = max(highs[k], value)
+            for k in range(chain.shape[0]):
                 a = chain[k]
                 for d in range(dim):
                     peak = max(peak, fabs(points[f, a, d]))
@@ -45,7 +59,12 @@ def chain_steps(const real[:, :, ::1] points, const intp[::1] chain, double scal
                     diff = points[f, b, d] * scale - points[f, a, d] * scale
                     total = diff * diff if d == 0 else total + diff * diff
                 steps[k, f] = sqrt(total)
-    return peak
+        if n_points:
+            low, high = lows[0], highs[0]
+            for k in range(1, n_points):
+                low = min(low, lows[k])
+                high = max(high, highs[k])
+    return peak, low, high
 
 
 cdef inline void _mean(const real[:, :, ::1] points, intp f, const intp[::1] members,
