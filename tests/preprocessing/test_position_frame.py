@@ -72,13 +72,14 @@ def test_3d_matches_the_per_frame_definition(up, floor, dtype):
 
 @pytest.mark.parametrize("up", ["y", "-y"])
 @pytest.mark.parametrize("mirror", [False, True])
-def test_2d_matches_the_per_frame_definition(up, mirror):
+@pytest.mark.parametrize("floor", ["lowest", 0.5])
+def test_2d_matches_the_per_frame_definition(up, mirror, floor):
     points = _walk(50, 2, seed=3)
     points[:, 2:4, 0] += -20.0 if mirror else 20.0  # the left joints on one side of the right
     roles = dict(root=(0,), lefts=(2, 3), rights=(4, 5), outputs=[6, 0, 2])
-    reference = _reference_2d(points, chain=(6, 0, 2), up=up, floor=0.5, rate=25.0, **roles)
+    reference = _reference_2d(points, chain=(6, 0, 2), up=up, floor=floor, rate=25.0, **roles)
     out = position_frame_features(
-        points, size_chain=(6, 0, 2), up=up, floor=0.5, frame_rate=25.0, chunk=7, **roles
+        points, size_chain=(6, 0, 2), up=up, floor=floor, frame_rate=25.0, chunk=7, **roles
     )
     np.testing.assert_allclose(out, reference.reshape(len(points), -1), rtol=1e-12, atol=1e-12)
 
