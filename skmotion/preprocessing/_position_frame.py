@@ -139,6 +139,8 @@ def position_frame_features(
         When a point index is out of range.
     """
     n_frames, n_points, dim = points.shape
+    if dim not in (2, 3):
+        raise ValueError(f"points need 2 or 3 coordinates each; got {dim}")
     if dim == 2 and up not in ("y", "-y"):
         raise ValueError(f"2-D points need up='y' or up='-y' (image rows); got {up!r}")
     if velocities and frame_rate is None:

@@ -111,3 +111,21 @@ def test_bad_indices_and_missing_rate_are_clear_errors():
         position_frame_features(points, root=(0,), lefts=(), rights=(), velocities=False)
     with pytest.raises(ValueError, match="velocities need frame_rate"):
         position_frame_features(points, **roles)
+    with pytest.raises(ValueError, match="points need 2 or 3 coordinates each; got 4"):
+        position_frame_features(np.zeros((10, 7, 4)), velocities=False, **roles)
+
+
+def test_read_only_strided_and_integer_inputs_give_the_same_features():
+    points = _walk(40, 3, seed=2)
+    kw = dict(root=(0,), lefts=(2,), rights=(4,), size_chain=(6, 0), frame_rate=10.0)
+    expected = position_frame_features(points, **kw)
+    frozen = points.copy()
+    frozen.flags.writeable = False
+    np.testing.assert_array_equal(position_frame_features(frozen, **kw), expected)
+    strided = np.zeros((40, 7, 6))
+    strided[..., ::2] = points
+    np.testing.assert_array_equal(position_frame_features(strided[..., ::2], **kw), expected)
+    whole = np.round(points * 10).astype(np.int64)
+    np.testing.assert_array_equal(
+        position_frame_features(whole, **kw), position_frame_features(whole * 1.0, **kw)
+    )
