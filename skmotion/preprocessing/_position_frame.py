@@ -14,9 +14,9 @@ fast where a direct formula is not:
   coordinates) is a clear error instead of a division by zero;
 - **speed**: the per-frame work (facing vector, ``M``, ``t``, the products,
   the velocities) is one compiled loop (``_position_frame_loops.pyx``) that
-  reads each frame once and writes its output once: over 10^6 frames per
+  reads each frame once and writes its output once: over 2 * 10^6 frames per
   second on one core, where numpy's gathers, batched ``matmul`` and shift were
-  memory passes of their own (4 times slower);
+  memory passes of their own (3.5 to 5.5 times slower; docs/positions.md);
 - **memory**: the output array is allocated once and written in place; the
   only temporary is the chain's step lengths (one value per frame and step).
 """
