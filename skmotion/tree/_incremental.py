@@ -46,7 +46,7 @@ __all__ = [
 
 
 def check_growth_params(split_growth, rebuild_tol, rebuild_growth=None):
-    """Validate ``split_growth`` and ``rebuild_growth`` (None or > 1), ``rebuild_tol`` (None or > 0)."""
+    """Check the growth parameters: the two growths None or > 1, ``rebuild_tol`` None or > 0."""
     for name, value in (("split_growth", split_growth), ("rebuild_growth", rebuild_growth)):
         if value is not None and not (
             isinstance(value, Real) and not isinstance(value, bool) and value > 1
@@ -178,7 +178,8 @@ class LiveDatabase:
     @classmethod
     def from_clips(cls, tree, clips, center, scale):
         """For a tree built from these clips (or any tree they are routed through)."""
-        clips = [np.array(c, dtype=np.float64) for c in clips]  # copies: the caller may reuse its arrays
+        # copies: the caller may change its arrays
+        clips = [np.array(c, dtype=np.float64) for c in clips]
         frames = (np.concatenate(clips) - center) / scale
         return cls(tree, node_moments(tree, frames, tree.covariance_type), clips, center, scale)
 
