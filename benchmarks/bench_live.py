@@ -61,6 +61,9 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA, cmu_windows, interleaved, time_call, write_results  # noqa: E402
 
+if os.environ.get("SKMOTION_BENCH_BASELINE"):  # a --baseline worker: that folder's skmotion,
+    sys.path.insert(0, os.environ["SKMOTION_BENCH_BASELINE"])  # ahead of this checkout
+
 # A worktree outside the project folder finds the data through the tests' variable.
 SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
 
@@ -373,8 +376,9 @@ def baseline_cost(quick, baseline, rounds=3):
     for r in range(rounds):
         for version, path in (("this checkout", None), ("baseline", baseline)):
             env = dict(os.environ)
+            env.pop("SKMOTION_BENCH_BASELINE", None)
             if path is not None:
-                env["PYTHONPATH"] = str(Path(path).resolve())
+                env["SKMOTION_BENCH_BASELINE"] = str(Path(path).resolve())
             cmd = [sys.executable, str(here), "--single-frame-worker"] + (["--quick"] * quick)
             out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
             row = {"version": version, "round": r + 1} | json.loads(out.stdout.splitlines()[-1])

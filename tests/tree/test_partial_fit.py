@@ -211,7 +211,15 @@ def test_after_fit_diag_merges_and_full_raises():
 
 
 @pytest.mark.parametrize(
-    "bad", [{"split_growth": 1.0}, {"rebuild_tol": 0}, {"split_growth": "x"}, {"classes": "dance"}]
+    "bad",
+    [
+        {"split_growth": 1.0},
+        {"rebuild_tol": 0},
+        {"split_growth": "x"},
+        {"rebuild_growth": 0.5},
+        {"rebuild_growth": True},
+        {"classes": "dance"},
+    ],
 )
 def test_bad_growth_parameters(bad):
     with pytest.raises(ValueError, match=next(iter(bad))):
