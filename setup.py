@@ -26,14 +26,7 @@ online = Extension(
         "skmotion/tree/_emission.h",
         "skmotion/tree/_emission.pxd",
         "skmotion/tree/_pairs.pxd",
-        "skmotion/tree/_online_state.pxd",
     ],
     extra_compile_args=["-O3", "-fopenmp-simd"],
 )
-# The answers of one update of the causal stream, filled by _online.
-online_state = Extension(
-    "skmotion.tree._online_state",
-    ["skmotion/tree/_online_state.pyx"],
-    extra_compile_args=["-O3"],
-)
-setup(ext_modules=cythonize([beam, online, online_state]))
+setup(ext_modules=cythonize([beam, online]))

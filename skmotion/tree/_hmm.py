@@ -842,8 +842,8 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
           Each frame's candidates are the children of its kept nodes, scored
           by forward max-product recursions on the global graph (the state)
           and on each class graph (a running log-likelihood per class); a
-          frame costs the same whatever came before (about 15 to 30
-          microseconds per single-frame update for 32 markers), and the
+          frame costs the same whatever came before (about 15
+          microseconds of CPU per single-frame update for 32 markers), and the
           state is ``O(beam x layers)`` numbers. Its
           answers are not the batch ones: the batch beam keeps the nodes with
           the best forward + backward scores over the whole clip, which no
