@@ -68,7 +68,10 @@ def _first_call(est, X, y, classes):
 
 def _build(est, clips, labels, classes):
     """The database ``fit`` builds from ``clips``; then the declared classes without clips."""
+    names = getattr(est, "feature_names_in_", None)  # the clips kept are arrays: keep the names
     est.fit(clips, labels)
+    if names is not None:
+        est.feature_names_in_ = names
     est._live = LiveDatabase.from_clips(est.tree_, clips, est.center_, est.scale_)
     est._live.labels = labels
     if classes is not None and len(np.setdiff1d(classes, est.classes_)):

@@ -338,3 +338,27 @@ def test_a_doubled_subtree_is_rebuilt_by_the_build_rule():
         np.testing.assert_allclose(alone.threshold[0], tree.threshold[v], rtol=1e-9)
     assert len(inside) > 1 and "new" in model.classes_
     check_against_one_shot(model, CLIPS + new, list(LABELS) + ["new"])
+
+
+def test_a_rebuilt_database_keeps_the_channel_names_of_dataframes():
+    import warnings
+
+    import pandas as pd
+
+    def frame(indices):
+        parts = {i: pd.DataFrame(CLIPS[i], columns=[f"ch{j}" for j in range(12)]) for i in indices}
+        return pd.concat(parts, names=["clip", "frame"])
+
+    model = MotionTreeHMM(max_depth=3, min_samples_leaf=8).partial_fit(
+        frame([0, 4]), LABELS[[0, 4]]
+    )
+    center = model.center_
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "fitted without feature names" on the way
+        for i in (1, 2, 3, 5):
+            model.partial_fit(frame([i]), LABELS[[i]])
+        assert model.center_ is not center  # the frames doubled: rebuilt on the way
+        assert list(model.feature_names_in_) == [f"ch{j}" for j in range(12)]
+        np.testing.assert_array_equal(model.predict(frame(range(12))), model.predict(CLIPS))
+    with pytest.raises(ValueError, match="ch"):
+        model.partial_fit(frame([6]).rename(columns={"ch0": "other"}), LABELS[[6]])
