@@ -3,7 +3,7 @@
 Result tables, all measured in one run:
 
 - ``live_update_cost``: seconds per ``partial_fit`` call adding one clip
-  (without splits) against the tree's depth, split into a cost per added frame
+  (without splits or rebuilds) against the tree's depth, split into a cost per added frame
   (the slope between clips of 20 and 1000 frames) and a fixed cost per call, and
   the ratio to rebuilding the database with ``fit``; also the per-frame work
   alone (routing, moment merges, transition counts of a 1000-frame clip); 60
@@ -11,10 +11,14 @@ Result tables, all measured in one run:
 - ``live_growth``: test accuracy of a database grown clip by clip
   (``partial_fit``; the first call holds one clip per class, the rest arrive
   one at a time in a shuffled order) against one rebuilt from all training
-  clips (``fit``), with the same (default) hyperparameters: BasicMotions and
-  JapaneseVowels (the archive's split), the synthetic motions (subject 3 held
-  out) and CMU subject 02 in 1 s windows of virtual markers (split by time
-  inside each trial, as in ``bench_tree.py``).
+  clips (``fit``), with the same (default) hyperparameters, for three growth
+  settings (the defaults, also over three clip orders; leaves only; no
+  splits), with the number of clips
+  held at the grown database's last whole build; and the accuracy of ``fit``
+  on five random 90% subsets of the training clips (how much a rebuild moves
+  itself): BasicMotions and JapaneseVowels (the archive's split), the
+  synthetic motions (subject 3 held out) and CMU subject 02 in 1 s windows of
+  virtual markers (split by time inside each trial, as in ``bench_tree.py``).
 - ``live_stream_cost``: microseconds per frame of ``stream().update`` on a clip
   of 32 virtual markers (192 channels), for the exact stream (window of 30
   frames, or all frames) and the online one, against the chunk size; the ratio
@@ -22,7 +26,12 @@ Result tables, all measured in one run:
   alternation) and to the exact stream with a 30-frame window; also the fastest
   of five more runs (the cost with the least interference from other jobs), and
   the online stream's single-frame cost after 3000 frames (the same frames
-  again: a cost that does not grow with the stream).
+  again: a cost that does not grow with the stream). "CPU us" columns are the
+  thread's CPU time (``time.thread_time``), which a shared machine disturbs
+  far less than the wall clock.
+- ``live_stream_baseline`` (with ``--baseline DIR``): the online stream's cost
+  per frame, fed frame by frame and in one chunk, of this checkout and of an
+  older built skmotion in ``DIR``, in alternating subprocesses.
 - ``live_online_agreement``: the online (causal) stream against the batch
   answers, per data set: the share of frames whose current node (and node
   ``lag`` = 5 frames back) equals the batch ``decode`` of the whole clip at the
@@ -51,6 +60,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA, cmu_windows, interleaved, time_call, write_results  # noqa: E402
+
+if os.environ.get("SKMOTION_BENCH_BASELINE"):  # a --baseline worker: that folder's skmotion,
+    sys.path.insert(0, os.environ["SKMOTION_BENCH_BASELINE"])  # ahead of this checkout
 
 # A worktree outside the project folder finds the data through the tests' variable.
 SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
@@ -101,14 +113,22 @@ def datasets(quick):
 
 
 def grow(model, X, y, *, seed=0, **kwargs):
-    """partial_fit: one clip per class first, then the others one by one in a shuffled order."""
+    """partial_fit: one clip per class first, then the others one by one in a shuffled order.
+
+    Returns the model and the number of clips held at its last whole build
+    (the first call, or a rebuild of the root: a new standardisation).
+    """
     y = np.asarray(y)
     first = [int(np.flatnonzero(y == c)[0]) for c in np.unique(y)]
     rest = [i for i in np.random.default_rng(seed).permutation(len(X)) if i not in first]
     model.partial_fit([X[i] for i in first], y[first], **kwargs)
-    for i in rest:
+    last_build = len(first)
+    for n, i in enumerate(rest, start=len(first) + 1):
+        center = model.center_
         model.partial_fit([X[i]], y[i : i + 1], **kwargs)
-    return model
+        if model.center_ is not center:
+            last_build = n
+    return model, last_build
 
 
 def _seconds_per_call(model, clip, label, n_calls):
@@ -116,7 +136,7 @@ def _seconds_per_call(model, clip, label, n_calls):
     times = []
     for _ in range(n_calls):
         start = time.perf_counter()
-        model.partial_fit([clip], [label], split_growth=None)
+        model.partial_fit([clip], [label], split_growth=None, rebuild_growth=None)
         times.append(time.perf_counter() - start)
     return float(np.median(times))
 
@@ -168,28 +188,59 @@ def update_cost(quick):
     return rows
 
 
-def growth(sets):
+GROWTH_SETTINGS = (  # (label, partial_fit keyword arguments)
+    ("grown (defaults: split_growth=2, rebuild_growth=2)", {}),
+    ("grown, leaves only (rebuild_growth=None)", {"rebuild_growth": None}),
+    ("grown, no splits (both None)", {"split_growth": None, "rebuild_growth": None}),
+)
+
+
+def growth(sets, n_subsets=5, n_orders=3):
     rows = []
     for name, loader in sets.items():
         Xtr, ytr, Xte, yte = loader()
+        ytr = np.asarray(ytr)
         rebuilt = MotionTreeHMM().fit(Xtr, ytr)
         row = {
             "data": name,
             "train clips": len(Xtr),
+            "test clips": len(Xte),
             "rebuilt accuracy": rebuilt.score(Xte, yte),
+            "rebuilt, nodes": rebuilt.tree_.n_tree_nodes,
         }
-        for label, kwargs in (
-            ("grown, no splits", {"split_growth": None}),
-            ("grown, splits x2", {}),
-            ("grown, splits x2 + rebuild 1 sd", {"rebuild_tol": 1.0}),
-        ):
+        start = time.perf_counter()
+        MotionTreeHMM().fit(Xtr, ytr)
+        row["rebuild (fit) s"] = time.perf_counter() - start
+        for label, kwargs in GROWTH_SETTINGS:
             start = time.perf_counter()
-            model = grow(MotionTreeHMM(), Xtr, ytr, **kwargs)
-            seconds = time.perf_counter() - start
+            model, last_build = grow(MotionTreeHMM(), Xtr, ytr, **kwargs)
             row[label] = model.score(Xte, yte)
+            row[label + " - rebuilt"] = row[label] - row["rebuilt accuracy"]
             row[label + ", nodes"] = model.tree_.n_tree_nodes
-            row[label + ", s"] = seconds
-        row["rebuilt, nodes"] = rebuilt.tree_.n_tree_nodes
+            row[label + ", clips at the last whole build"] = last_build
+            row[label + ", s"] = time.perf_counter() - start
+        # the defaults again, clips in other orders: the gap is not one order's chance
+        label = GROWTH_SETTINGS[0][0]
+        scores = [row[label]] + [
+            grow(MotionTreeHMM(), Xtr, ytr, seed=seed)[0].score(Xte, yte)
+            for seed in range(1, n_orders)
+        ]
+        row[f"defaults, {n_orders} orders: mean - rebuilt"] = (
+            float(np.mean(scores)) - row["rebuilt accuracy"]
+        )
+        row[f"defaults, {n_orders} orders: min"] = float(np.min(scores))
+        row[f"defaults, {n_orders} orders: max"] = float(np.max(scores))
+        # how much a rebuild itself moves when a tenth of the clips is left out: the
+        # spread of accuracies that differently grown trees of the same data may have
+        rng = np.random.default_rng(0)
+        scores = []
+        for _ in range(n_subsets):
+            keep = np.sort(rng.permutation(len(Xtr))[: int(0.9 * len(Xtr))])
+            sub = MotionTreeHMM().fit([Xtr[i] for i in keep], ytr[keep])
+            scores.append(sub.score(Xte, yte))
+        row["rebuilt on 90% of the clips: mean"] = float(np.mean(scores))
+        row["rebuilt on 90%: min"] = float(np.min(scores))
+        row["rebuilt on 90%: max"] = float(np.max(scores))
         rows.append(row)
         print(row)
     return rows
@@ -246,6 +297,7 @@ def stream_cost(quick):
             seconds, batch_s = interleaved([run, batch], rounds=3)
             # the least-disturbed run: the cost on an idle core, as near as a shared machine gets
             fastest = min(time_call(run, repeats=1, warmup=0)[0] for _ in range(5))
+            cpu = _cpu_seconds(run)
             rows.append(
                 {
                     "data": source,
@@ -256,6 +308,7 @@ def stream_cost(quick):
                     "chunk": chunk,
                     "us per frame": 1e6 * seconds / n,
                     "us per frame, fastest of 5": 1e6 * fastest / n,
+                    "CPU us per frame": 1e6 * cpu / n,
                     "us per update": 1e6 * seconds / -(-n // chunk),
                     "batch predict+decode, us per frame": 1e6 * batch_s / n,
                     "stream / batch": seconds / batch_s,
@@ -269,18 +322,84 @@ def stream_cost(quick):
     return rows
 
 
+def _cpu_seconds(run, repeats=5):
+    """Median CPU seconds of this thread in ``run()``: the work itself, without the waits for
+    a core that a shared machine adds to the wall clock (caches are still shared)."""
+    times = []
+    for _ in range(repeats):
+        start = time.thread_time()
+        run()
+        times.append(time.thread_time() - start)
+    return float(np.median(times))
+
+
+def _single_frame_cost(quick):
+    """The online stream fed frame by frame (and in one chunk), in this process's skmotion."""
+    model, clip, source = stream_clip(quick)
+    clip = np.ascontiguousarray(clip[: min(len(clip), 120 if quick else 300)])
+    stream = model.stream()
+
+    def frames():
+        stream.reset()
+        for frame in clip:
+            stream.update(frame)
+
+    def chunk():
+        stream.reset().update(clip)
+
+    wall = interleaved([frames, chunk], rounds=5)
+    n = len(clip)
+    return {
+        "data": source,
+        "channels": clip.shape[1],
+        "layers": model.n_layers_,
+        "frames": n,
+        "CPU us per frame, 1 frame per update": 1e6 * _cpu_seconds(frames, 7) / n,
+        "CPU us per frame, one chunk": 1e6 * _cpu_seconds(chunk, 7) / n,
+        "us per frame, 1 frame per update (wall)": 1e6 * wall[0] / n,
+        "us per frame, one chunk (wall)": 1e6 * wall[1] / n,
+    }
+
+
+def baseline_cost(quick, baseline, rounds=3):
+    """The single-frame cost of this checkout against an older one, alternating in subprocesses.
+
+    ``baseline`` is a folder holding an importable, built ``skmotion`` (a wheel
+    unpacked, or a checkout built in place); each round runs one worker per
+    version, one after the other, so both see the same load.
+    """
+    import json
+    import subprocess
+
+    here = Path(__file__).resolve()
+    rows = []
+    for r in range(rounds):
+        for version, path in (("this checkout", None), ("baseline", baseline)):
+            env = dict(os.environ)
+            env.pop("SKMOTION_BENCH_BASELINE", None)
+            if path is not None:
+                env["SKMOTION_BENCH_BASELINE"] = str(Path(path).resolve())
+            cmd = [sys.executable, str(here), "--single-frame-worker"] + (["--quick"] * quick)
+            out = subprocess.run(cmd, env=env, capture_output=True, text=True, check=True)
+            row = {"version": version, "round": r + 1} | json.loads(out.stdout.splitlines()[-1])
+            rows.append(row)
+            print(row)
+    return rows
+
+
 def _online_after(model, clip, source, batch, n_before=3000):
     """The online stream's single-frame cost after ``n_before`` frames: the same as at the start."""
     n = len(clip)
     stream = model.stream()
     before = np.resize(clip, (n_before, clip.shape[1]))  # the clip again and again
-    times = []
+    times, cpu = [], []
     for _ in range(3):
         stream.reset().update(before)
-        start = time.perf_counter()
+        start, start_cpu = time.perf_counter(), time.thread_time()
         for frame in clip:
             stream.update(frame)
         times.append(time.perf_counter() - start)
+        cpu.append(time.thread_time() - start_cpu)
     batch_s = time_call(batch, repeats=3)[0]
     seconds, fastest = float(np.median(times)), min(times)
     return {
@@ -292,6 +411,7 @@ def _online_after(model, clip, source, batch, n_before=3000):
         "chunk": 1,
         "us per frame": 1e6 * seconds / n,
         "us per frame, fastest of 5": 1e6 * fastest / n,  # of 3 here
+        "CPU us per frame": 1e6 * float(np.median(cpu)) / n,
         "us per update": 1e6 * seconds / n,
         "batch predict+decode, us per frame": 1e6 * batch_s / n,
         "stream / batch": seconds / batch_s,
@@ -418,7 +538,18 @@ def main():
         nargs="*",
         help="update, growth, stream, latency, agreement, synthesis (default: all)",
     )
+    parser.add_argument(
+        "--baseline",
+        help="with the stream study: a folder holding an older built skmotion whose "
+        "single-frame cost is measured in alternation with this one (live_stream_baseline)",
+    )
+    parser.add_argument("--single-frame-worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.single_frame_worker:
+        import json
+
+        print(json.dumps(_single_frame_cost(args.quick)))
+        return
     only = set(args.only or ["update", "growth", "stream", "latency", "agreement", "synthesis"])
     sets = datasets(args.quick)
     note = "Shared machine: compare ratios within one run. Default MotionTreeHMM parameters."
@@ -426,6 +557,9 @@ def main():
         write_results("live_update_cost", update_cost(args.quick), notes=note)
     if "stream" in only:
         write_results("live_stream_cost", stream_cost(args.quick), notes=note)
+        if args.baseline:
+            rows = baseline_cost(args.quick, args.baseline)
+            write_results("live_stream_baseline", rows, notes=note)
     if "growth" in only:
         write_results("live_growth", growth(sets), notes=note)
     if "latency" in only:

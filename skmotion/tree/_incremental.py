@@ -4,19 +4,27 @@ Yamane, Yamaguchi and Nakamura build their database once, from all frames, and
 list incremental learning as future work. Here new frames are routed down the
 existing splits; every node they pass through merges their moments exactly
 (:class:`~skmotion.tree._moments.Moments`), and the transition counts of their
-clips are added to the graphs. Two local changes keep the tree fitting the data:
+clips are added to the graphs. Local changes keep the tree the one the build
+would make:
 
-- a leaf whose frame count has grown by ``split_growth`` times since it was
-  last looked at is split by the build's rule (its frames' first principal
-  axis, the same cut criterion and limits), recursively, as the build would;
+- a leaf is split by the build's rule (its frames' first principal axis, the
+  same cut criterion and limits), recursively, as the build would, when it
+  reaches ``min_samples_split`` frames (the build splits any node that large)
+  or its frame count has grown ``split_growth`` times since it was last tried;
+- a split node whose frame count has grown ``rebuild_growth`` times since its
+  subtree was built has the subtree grown again from its frames: its axis and
+  cut were chosen on a part of the frames it holds now. At the root this is
+  the whole database, built again as ``fit`` builds it from all clips so far
+  (standardisation included: see ``_partial_fit``);
 - a split node whose mean has moved more than ``rebuild_tol`` of its standard
   deviation (``sqrt(trace(cov) / d)`` when the split was made) is rebuilt
-  locally: its subtree is grown again from its frames.
+  locally too.
 
-Both need the frames, which the database keeps (standardised, clip by clip):
-a tree built by ``fit`` has none, so its nodes only merge moments. Node
-statistics never depend on the order clips arrive in (up to rounding); the
-structure does, through the moments at which leaves are split.
+All of these need the frames, which the database keeps (the clips as given,
+standardised when needed): a tree built by ``fit`` has none, so its nodes only
+merge moments. Node statistics never depend on the order clips arrive in (up
+to rounding); the structure does, through the moments at which nodes are
+grown again.
 """
 
 from numbers import Real
@@ -37,12 +45,13 @@ __all__ = [
 ]
 
 
-def check_growth_params(split_growth, rebuild_tol):
-    """Validate ``split_growth`` (None or > 1) and ``rebuild_tol`` (None or > 0)."""
-    if split_growth is not None and not (
-        isinstance(split_growth, Real) and not isinstance(split_growth, bool) and split_growth > 1
-    ):
-        raise ValueError(f"split_growth must be a number > 1 or None; got {split_growth!r}.")
+def check_growth_params(split_growth, rebuild_tol, rebuild_growth=None):
+    """Check the growth parameters: the two growths None or > 1, ``rebuild_tol`` None or > 0."""
+    for name, value in (("split_growth", split_growth), ("rebuild_growth", rebuild_growth)):
+        if value is not None and not (
+            isinstance(value, Real) and not isinstance(value, bool) and value > 1
+        ):
+            raise ValueError(f"{name} must be a number > 1 or None; got {value!r}.")
     if rebuild_tol is not None and not (
         isinstance(rebuild_tol, Real) and not isinstance(rebuild_tol, bool) and rebuild_tol > 0
     ):
@@ -143,61 +152,72 @@ def _layers_of(left, right, root=0):
 
 
 class LiveDatabase:
-    """What ``partial_fit`` keeps between calls: node moments, frames and split bookkeeping.
+    """What ``partial_fit`` keeps between calls: node moments, clips and split bookkeeping.
 
     Parameters
     ----------
     tree : MotionTree
         The tree this state describes.
     moments : Moments
-        Per tree node, the moments of its frames.
-    frames : list of ndarray or None
-        The standardised clips seen so far (None: unknown, the tree came from ``fit``).
+        Per tree node, the moments of its (standardised) frames.
+    clips : list of ndarray or None
+        The clips seen so far, as given (None: unknown, the tree came from ``fit``).
+    center, scale : ndarray of shape (n_channels,)
+        The standardisation of the tree's frames: ``(clip - center) / scale``.
     """
 
-    def __init__(self, tree, moments, frames):
+    def __init__(self, tree, moments, clips, center, scale):
         self.tree = tree
         self.moments = moments
-        self.frames = frames
+        self.clips = clips
+        self.center, self.scale = center, scale
         self.checked = moments.count.copy()
         self.split_mean = moments.mean.copy()
         self.split_scale = _spread(moments)
 
     @classmethod
-    def from_frames(cls, tree, clips):
-        frames = np.concatenate(clips)
-        return cls(tree, node_moments(tree, frames, tree.covariance_type), list(clips))
+    def from_clips(cls, tree, clips, center, scale):
+        """For a tree built from these clips (or any tree they are routed through)."""
+        # copies: the caller may change its arrays
+        clips = [np.array(c, dtype=np.float64) for c in clips]
+        frames = (np.concatenate(clips) - center) / scale
+        return cls(tree, node_moments(tree, frames, tree.covariance_type), clips, center, scale)
 
     @classmethod
-    def from_tree(cls, tree):
-        """For a tree built by ``fit``: moments recovered from its estimates, frames unknown."""
+    def from_tree(cls, tree, center, scale):
+        """For a tree built by ``fit``: moments recovered from its estimates, clips unknown."""
         moments = Moments.from_estimates(
             tree.count, tree.mean, tree.covariance, tree.covariance_type, tree.reg
         )
-        return cls(tree, moments, None)
+        return cls(tree, moments, None, center, scale)
 
-    def add(self, clips, *, split_growth, rebuild_tol, build_params):
-        """Merge new standardised clips; split and rebuild where due.
+    def standardised(self, clips=None):
+        """The clips (all kept ones by default) standardised, one array."""
+        clips = self.clips if clips is None else clips
+        return (np.concatenate(clips) - self.center) / self.scale
+
+    def add(self, clips, *, split_growth, rebuild_growth, rebuild_tol, build_params):
+        """Merge new clips; split and rebuild where due (the root excepted: see ``_partial_fit``).
 
         Returns whether the tree's structure changed.
         """
         tree = self.tree
-        added = node_moments(tree, np.concatenate(clips), tree.covariance_type)
+        added = node_moments(tree, self.standardised(clips), tree.covariance_type)
         self.moments = self.moments.merged(added)
         # a node that changed loses its low-rank form: the decoder then uses the
         # triangular factor of the same covariance
         low_rank = None
         if tree.covariance_type == "full":
             low_rank = [None if c else lr for c, lr in zip(added.count, tree.low_rank)]
-        if self.frames is None:
+        if self.clips is None:
             self.tree = _with_moments(tree, self.moments, low_rank)
             return False
-        self.frames.extend(clips)
-        regrow = self._due(split_growth, rebuild_tol, build_params.get("max_depth"))
+        self.clips.extend(np.array(c, dtype=np.float64) for c in clips)
+        regrow = self._due(split_growth, rebuild_growth, rebuild_tol, build_params)
         if not regrow:
             self.tree = _with_moments(tree, self.moments, low_rank)
             return False
-        all_frames = np.concatenate(self.frames)
+        all_frames = self.standardised()
         changed = False
         while regrow:
             new_id = self._regrow(regrow.pop(0), all_frames, build_params)
@@ -207,17 +227,33 @@ class LiveDatabase:
         self.tree = _with_moments(self.tree, self.moments)
         return changed
 
-    def _due(self, split_growth, rebuild_tol, max_depth):
-        """Nodes to grow again: topmost drifted split nodes, then grown leaves outside them."""
+    def root_due(self, n_new, rebuild_growth):
+        """Whether the root, with ``n_new`` more frames, has grown ``rebuild_growth`` times."""
+        return (
+            rebuild_growth is not None
+            and self.clips is not None
+            and self.moments.count[0] + n_new >= rebuild_growth * self.checked[0]
+        )
+
+    def _due(self, split_growth, rebuild_growth, rebuild_tol, params):
+        """Nodes to grow again: topmost grown or drifted split nodes, then leaves outside them."""
         tree, m = self.tree, self.moments
         split = tree.left >= 0
         due = np.zeros(len(split), bool)
         if rebuild_tol is not None:
             shift = np.sqrt(((m.mean - self.split_mean) ** 2).sum(axis=1))
             due |= split & (shift > rebuild_tol * self.split_scale)
+        if rebuild_growth is not None:
+            due[1:] |= split[1:] & (m.count[1:] >= rebuild_growth * self.checked[1:])
         if split_growth is not None:
+            max_depth = params["max_depth"]
             room = np.ones(len(split), bool) if max_depth is None else tree.depth < max_depth
-            due |= ~split & room & (m.count >= split_growth * self.checked)
+            # the build splits every node of min_split frames (when a cut is admissible)
+            min_split = max(params["min_samples_split"], 2 * params["min_samples_leaf"], 2)
+            grown = (m.count >= split_growth * self.checked) | (
+                (self.checked < min_split) & (m.count >= min_split)
+            )
+            due |= ~split & room & grown
         nodes = np.flatnonzero(due)
         # a node inside another's subtree is regrown with it
         covered = set()

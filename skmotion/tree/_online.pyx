@@ -25,12 +25,20 @@ to the layer's offset (so scores stay near 0 on an endless stream; the
 differences, hence every decision, are those of the plain sums up to rounding).
 The state lives in numpy arrays owned by the caller (they pickle); this object
 holds only pointers to them and to the model's tables.
+
+A single float64 frame can go through :meth:`OnlineKernel.step`, which checks
+its buffer in C (no Python between the call and the frame's work); the answers
+come back as an :class:`OnlineState`, filled in C and read lazily.
 """
+
+from collections.abc import Mapping
 
 import numpy as np
 
+from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBuffer_Release, PyObject_GetBuffer
 from libc.math cimport INFINITY, exp, log1p
 from libc.stdlib cimport free, malloc
+from libc.string cimport memcpy
 
 from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
 from skmotion.tree._pairs cimport pair_moves
@@ -68,20 +76,162 @@ cdef inline const double* _moves(const Table* t, intp src, intp dst) noexcept no
     return pair_moves(t.pair_start, t.pair_dst, t.pair_log, t.unseen_log, t.n_cols, src, dst)
 
 
-cdef inline void _top(double* pool, intp m, double* out, intp P) noexcept nogil:
-    """The ``P`` largest of ``pool[:m]``, largest first, into ``out`` (-inf past ``m``); ``pool`` is spoilt."""
-    cdef intp r, i, arg
-    cdef double best
-    for r in range(P):
-        arg = -1
-        best = -INFINITY
-        for i in range(m):
-            if pool[i] > best:
-                best = pool[i]
-                arg = i
-        out[r] = best
-        if arg >= 0:
-            pool[arg] = -INFINITY
+cdef inline void _push(double v, double* out, intp P) noexcept nogil:
+    """Put ``v`` into ``out[:P]``, the largest values so far in decreasing order, if it beats the last.
+
+    Pushing every value of a list into ``out`` filled with -inf leaves its ``P``
+    largest values, largest first (equal values are all kept; -inf and NaN never enter).
+    """
+    cdef intp r = P - 1
+    while r > 0 and v > out[r - 1]:
+        out[r] = out[r - 1]
+        r -= 1
+    out[r] = v
+
+
+KEYS = ("frame", "node", "nodes", "lagged_node", "proba", "label", "next_nodes", "next_proba")
+
+
+cdef class OnlineState:
+    """The stream's answers after an update; attributes, or keys as in a ``Bunch``.
+
+    A single-frame update must cost a few microseconds, and building a
+    ``Bunch`` of three new arrays costs more than the frame's compiled work:
+    the kernel writes the answers into the state's own C buffers, and the
+    arrays and ``label`` are made on first access and kept. They are the
+    answers at the update that returned the state: later updates do not
+    change it.
+
+    Attributes
+    ----------
+    frame : int
+        Index of the last frame seen.
+    node : int
+        The current node at the stream's layer.
+    nodes : ndarray of int
+        Its ancestors at layers ``0 .. layer`` (the node last).
+    lagged_node : int
+        The node ``lag`` frames back (-1 before ``lag + 1`` frames).
+    proba : ndarray of shape (n_classes,)
+        The class posterior.
+    label : object
+        The decision (an entry of the model's ``classes_``).
+    next_nodes, next_proba : ndarray of shape (n_best,)
+        The most likely nodes one frame ahead and their probabilities.
+    """
+
+    cdef readonly Py_ssize_t frame, node, lagged_node
+    cdef Py_ssize_t label_index, n_classes, n_best
+    cdef double* proba_buf        # (n_classes,) then (n_best,): proba, next_proba
+    cdef Py_ssize_t* next_buf     # (n_best,) next nodes
+    cdef object classes, ancestors
+    cdef object _proba, _next_nodes, _next_proba, _label, _nodes
+
+    def __cinit__(self):
+        self.proba_buf = NULL
+        self.next_buf = NULL
+
+    def __dealloc__(self):
+        free(self.proba_buf)
+        free(self.next_buf)
+
+    cdef int allocate(self, Py_ssize_t n_classes, Py_ssize_t n_best) except -1:
+        self.n_classes = n_classes
+        self.n_best = n_best
+        self.proba_buf = <double*> malloc((n_classes + n_best + 1) * sizeof(double))
+        self.next_buf = <Py_ssize_t*> malloc((n_best + 1) * sizeof(Py_ssize_t))
+        if self.proba_buf == NULL or self.next_buf == NULL:
+            raise MemoryError()
+        return 0
+
+    @property
+    def proba(self):
+        cdef double[::1] view
+        if self._proba is None:
+            self._proba = np.empty(self.n_classes)
+            view = self._proba
+            if self.n_classes:
+                memcpy(&view[0], self.proba_buf, self.n_classes * sizeof(double))
+        return self._proba
+
+    @property
+    def next_proba(self):
+        cdef double[::1] view
+        if self._next_proba is None:
+            self._next_proba = np.empty(self.n_best)
+            view = self._next_proba
+            if self.n_best:
+                memcpy(&view[0], self.proba_buf + self.n_classes, self.n_best * sizeof(double))
+        return self._next_proba
+
+    @property
+    def next_nodes(self):
+        cdef Py_ssize_t[::1] view
+        if self._next_nodes is None:
+            self._next_nodes = np.empty(self.n_best, dtype=np.intp)
+            view = self._next_nodes
+            if self.n_best:
+                memcpy(&view[0], self.next_buf, self.n_best * sizeof(Py_ssize_t))
+        return self._next_nodes
+
+    @property
+    def label(self):
+        if self._label is None:
+            self._label = self.classes[self.label_index]
+        return self._label
+
+    @property
+    def nodes(self):
+        if self._nodes is None:
+            self._nodes = self.ancestors[self.node].copy()
+        return self._nodes
+
+    # -- the mapping of a Bunch ------------------------------------------------------
+
+    def keys(self):
+        return KEYS
+
+    def values(self):
+        return [getattr(self, key) for key in KEYS]
+
+    def items(self):
+        return [(key, getattr(self, key)) for key in KEYS]
+
+    def get(self, key, default=None):
+        return getattr(self, key) if key in KEYS else default
+
+    def __getitem__(self, key):
+        if key not in KEYS:
+            raise KeyError(key)
+        return getattr(self, key)
+
+    def __contains__(self, key):
+        return key in KEYS
+
+    def __iter__(self):
+        return iter(KEYS)
+
+    def __len__(self):
+        return len(KEYS)
+
+    def __repr__(self):
+        return f"OnlineState(frame={self.frame}, node={self.node}, label={self.label!r})"
+
+    def __reduce__(self):
+        return (_from_values, (dict(self.items()),))
+
+
+def _from_values(values):
+    """An OnlineState holding given answers (unpickling)."""
+    cdef OnlineState out = OnlineState.__new__(OnlineState)
+    out.frame, out.node, out.lagged_node = values["frame"], values["node"], values["lagged_node"]
+    out._nodes, out._proba, out._label = values["nodes"], values["proba"], values["label"]
+    out._next_nodes, out._next_proba = values["next_nodes"], values["next_proba"]
+    out.n_classes, out.n_best = len(out._proba), len(out._next_nodes)
+    return out
+
+
+Mapping.register(OnlineState)
 
 
 cdef class OnlineKernel:
@@ -130,26 +280,34 @@ cdef class OnlineKernel:
     # scratch
     cdef double* new_delta
     cdef double* new_alpha
-    cdef double* pool        # (slots * n_paths,) the entries a list step picks from
     cdef double* new_emit
     cdef intp* new_cand
     cdef intp* parent_slot
     cdef intp* back
     cdef intp* union_slot    # (K at the stream layer,) a node's entry in the next-node union, -1 for none
     cdef double* y
+    cdef double* x           # (d,) a standardised frame
+    # the answers (set by `answers`): what `result` and the single-frame `step` need
+    cdef object _answers     # (model, tree, classes, ancestors, arrays kept alive)
+    cdef const intp* class_of_graph
+    cdef const double* center
+    cdef const double* scale
+    cdef intp n_classes, n_best, lag
+    cdef bint fast
 
     def __cinit__(self):
         self._layers = NULL
         self._n_made = 0
         self.new_delta = NULL
         self.new_alpha = NULL
-        self.pool = NULL
         self.new_emit = NULL
         self.new_cand = NULL
         self.parent_slot = NULL
         self.back = NULL
         self.union_slot = NULL
         self.y = NULL
+        self.x = NULL
+        self.fast = False
 
     def __init__(self, dict gauss, list layers, dict state, intp beam, intp n_graphs, intp n_paths,
                  intp stream_layer, intp ring):
@@ -179,20 +337,20 @@ cdef class OnlineKernel:
         cdef intp s = self.slots, g = max(n_graphs, 1)
         self.new_delta = <double*> malloc(s * sizeof(double))
         self.new_alpha = <double*> malloc(s * g * n_paths * sizeof(double))
-        self.pool = <double*> malloc(s * n_paths * sizeof(double))
         self.new_emit = <double*> malloc(s * sizeof(double))
         self.new_cand = <intp*> malloc(s * sizeof(intp))
         self.parent_slot = <intp*> malloc(s * sizeof(intp))
         self.back = <intp*> malloc(s * sizeof(intp))
         self.y = <double*> malloc(4 * max(self.d, 1) * sizeof(double))
+        self.x = <double*> malloc(max(self.d, 1) * sizeof(double))
         cdef intp k = self._layers[stream_layer - 1].k if stream_layer else 1, i
         self.union_slot = <intp*> malloc(k * sizeof(intp))
         if self.union_slot == NULL:
             raise MemoryError()
         for i in range(k):
             self.union_slot[i] = -1
-        if (self.new_delta == NULL or self.new_alpha == NULL or self.pool == NULL or self.new_emit == NULL or self.new_cand == NULL
-                or self.parent_slot == NULL or self.back == NULL or self.y == NULL):
+        if (self.new_delta == NULL or self.new_alpha == NULL or self.new_emit == NULL or self.new_cand == NULL
+                or self.parent_slot == NULL or self.back == NULL or self.y == NULL or self.x == NULL):
             raise MemoryError()
 
     def __dealloc__(self):
@@ -205,13 +363,13 @@ cdef class OnlineKernel:
         free(self._layers)
         free(self.new_delta)
         free(self.new_alpha)
-        free(self.pool)
         free(self.new_emit)
         free(self.new_cand)
         free(self.parent_slot)
         free(self.back)
         free(self.union_slot)
         free(self.y)
+        free(self.x)
 
     cdef void _set_gaussians(self, dict gauss):
         cdef const double[:, ::1] means = gauss["means"]
@@ -410,10 +568,11 @@ cdef class OnlineKernel:
         candidate ``j`` (decreasing in ``r``; -inf when there are fewer).
         """
         cdef const Layer* lay = &self._layers[l - 1]
-        cdef intp i, j, g, r, m, G = self.n_graphs, P = self.n_paths, n_prev = self.n_cand[l]
+        cdef intp i, j, g, r, G = self.n_graphs, P = self.n_paths, n_prev = self.n_cand[l]
         cdef intp size = n * G * P
-        cdef double e, move, top = -INFINITY
+        cdef double e, move, v, top = -INFINITY
         cdef const double* prev_alpha = self.alpha + l * self.slots * G * P
+        cdef const double* prev
         cdef const double* moves = NULL
         cdef intp cols = lay.table.n_cols
         cdef double* out
@@ -432,13 +591,16 @@ cdef class OnlineKernel:
                 if first:
                     out[0] = e
                 else:
-                    m = 0
+                    # each previous candidate's list is in decreasing order: once an entry
+                    # misses the best P so far, the rest of its list does too
                     for i in range(n_prev):
-                        move = moves[(i * n + j) * cols + 1 + g]
+                        move = moves[(i * n + j) * cols + 1 + g] + e
+                        prev = prev_alpha + (i * G + g) * P
                         for r in range(P):
-                            self.pool[m] = prev_alpha[(i * G + g) * P + r] + (move + e)
-                            m += 1
-                    _top(self.pool, m, out, P)
+                            v = prev[r] + move
+                            if not (v > out[P - 1]):
+                                break
+                            _push(v, out, P)
                 if out[0] > top:
                     top = out[0]
         if top == -INFINITY:
@@ -479,22 +641,98 @@ cdef class OnlineKernel:
         (then nothing is taken: the check runs over the whole chunk first).
         """
         cdef intp i, a, n = frames.shape[0], d = self.d
-        cdef double* x
+        cdef double* x = self.x
         for i in range(n):
             for a in range(d):
                 if not (frames[i, a] - frames[i, a] == 0.0):  # NaN or infinite
                     return i * d + a
-        x = <double*> malloc(d * sizeof(double))
-        if x == NULL:
-            raise MemoryError()
         with nogil:
             for i in range(n):
                 for a in range(d):
                     x[a] = (frames[i, a] - center[a]) / scale[a]
                 self._frame(x, self.counter[0])
                 self.counter[0] += 1
-        free(x)
         return -1
+
+    def answers(self, model, tree, classes, const intp[::1] class_of_graph, ancestors, intp n_best,
+                intp lag, const double[::1] center, const double[::1] scale, bint fast):
+        """What :meth:`result` reports and :meth:`step` checks: set once per stream.
+
+        ``fast``: single frames may take :meth:`step` (False under
+        ``node_prior="graph"``, whose normalisers are computed in numpy).
+        """
+        self._answers = (model, tree, classes, ancestors, class_of_graph, center, scale)
+        self.class_of_graph = &class_of_graph[0]
+        self.center = &center[0]
+        self.scale = &scale[0]
+        self.n_classes = len(classes)
+        self.n_best = n_best
+        self.lag = lag
+        self.fast = fast
+
+    def step(self, frame):
+        """One raw frame, the common case, with no Python between: the answers, or None.
+
+        The frame is taken when it is a C-contiguous float64 buffer of ``d``
+        finite values and the model has not been fit again; otherwise nothing
+        changes and None is returned (the caller's general path converts,
+        checks and explains).
+        """
+        cdef Py_buffer view
+        cdef intp a, d = self.d
+        cdef const double* f
+        cdef bint ok
+        if not self.fast or self._answers[0].tree_ is not self._answers[1]:
+            return None
+        try:
+            PyObject_GetBuffer(frame, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT)
+        except (BufferError, TypeError, ValueError):
+            return None
+        ok = view.ndim == 1 and view.shape[0] == d and view.format[0] == b"d" and view.format[1] == 0
+        if ok:
+            f = <const double*> view.buf
+            for a in range(d):
+                if not (f[a] - f[a] == 0.0):  # NaN or infinite
+                    ok = False
+                    break
+                self.x[a] = (f[a] - self.center[a]) / self.scale[a]
+        PyBuffer_Release(&view)
+        if not ok:
+            return None
+        with nogil:
+            self._frame(self.x, self.counter[0])
+            self.counter[0] += 1
+        return self.result()
+
+    cpdef OnlineState result(self):
+        """The answers now (after at least one frame).
+
+        ``proba``: the class posterior, each class's value being its best
+        graph's running log-likelihood (summed over the scored layers).
+        ``next_nodes``/``next_proba``: the kept nodes of the stream layer
+        weighted by their forward scores, carried one transition forward on
+        the global graph; ties go to the lower node.
+        """
+        cdef OnlineState out = OnlineState.__new__(OnlineState)
+        cdef intp L = self.stream_layer
+        out.allocate(self.n_classes, self.n_best)
+        out.frame = self.counter[0] - 1
+        out.classes = self._answers[2]
+        out.ancestors = self._answers[3]
+        if L:
+            out.node = self.cand[L * self.slots + self.kept[L * self.beam]]
+            out.lagged_node = self.lagged(self.lag)
+        else:
+            out.node = 0
+            out.lagged_node = 0 if self.counter[0] > self.lag else -1
+        out.label_index = self._posterior(self.class_of_graph, out.proba_buf, self.n_classes)
+        if self.n_best:
+            if L:
+                self._next(out.next_buf, out.proba_buf + self.n_classes, self.n_best)
+            else:
+                out.next_buf[0] = 0
+                out.proba_buf[self.n_classes] = 1.0
+        return out
 
     cpdef intp lagged(self, intp lag):
         """The stream layer's node ``lag`` frames back on the best sequence's backtrace, or -1."""
@@ -506,50 +744,27 @@ cdef class OnlineKernel:
             slot = self.ring_back[((t - k) % self.ring) * self.slots + slot]
         return self.ring_cand[((t - lag) % self.ring) * self.slots + slot]
 
-    def summary(self, intp lag, const intp[::1] class_of_graph, double[::1] proba, intp[::1] next_nodes,
-                double[::1] next_proba):
-        """The answers now: ``(node, lagged node, class index)``; fills ``proba`` and the next nodes.
-
-        ``proba`` (n_classes,): the class posterior, each class's value being
-        its best graph's running log-likelihood (summed over the scored
-        layers). ``next_nodes``/``next_proba`` (n_best,): the kept nodes of the
-        stream layer weighted by their forward scores, carried one transition
-        forward on the global graph; ties go to the lower node.
-        """
-        cdef intp node = 0, lag_node, label
-        cdef intp L = self.stream_layer
-        if L:
-            node = self.cand[L * self.slots + self.kept[L * self.beam]]
-            lag_node = self.lagged(lag)
-        else:
-            lag_node = 0 if self.counter[0] > lag else -1
-        label = self._posterior(class_of_graph, proba)
-        if next_nodes.shape[0]:
-            if L:
-                self._next(next_nodes, next_proba)
-            else:
-                next_nodes[0] = 0
-                next_proba[0] = 1.0
-        return node, lag_node, label
-
     cdef double _sum_of_paths(self, intp l, intp g) noexcept nogil:
         """``log sum exp`` of graph ``g``'s ``n_paths`` best sequences at layer ``l`` (as the batch sums them)."""
-        cdef intp j, r, m = 0, G = self.n_graphs, P = self.n_paths
+        cdef intp j, r, G = self.n_graphs, P = self.n_paths
         cdef double* best = self.new_alpha  # scratch: the step's buffer, free between frames
-        cdef double rest = 0.0
+        cdef double rest = 0.0, v
+        for r in range(P):
+            best[r] = -INFINITY
         for j in range(self.n_cand[l]):
-            for r in range(P):
-                self.pool[m] = self.alpha[((l * self.slots + j) * G + g) * P + r]
-                m += 1
-        _top(self.pool, m, best, P)
+            for r in range(P):  # each candidate's list is in decreasing order
+                v = self.alpha[((l * self.slots + j) * G + g) * P + r]
+                if not (v > best[P - 1]):
+                    break
+                _push(v, best, P)
         if best[0] == -INFINITY:
             return best[0]
         for r in range(1, P):
             rest += exp(best[r] - best[0])
         return best[0] + log1p(rest)
 
-    cdef intp _posterior(self, const intp[::1] class_of_graph, double[::1] proba):
-        cdef intp l, j, g, c, n_classes = proba.shape[0], G = self.n_graphs, arg = 0
+    cdef intp _posterior(self, const intp* class_of_graph, double* proba, intp n_classes) noexcept nogil:
+        cdef intp l, j, g, c, G = self.n_graphs, arg = 0
         cdef double* ll = <double*> malloc(max(G, 1) * sizeof(double))
         cdef double top = -INFINITY, total = 0.0
         for g in range(G):
@@ -580,10 +795,10 @@ cdef class OnlineKernel:
             proba[c] /= total
         return arg
 
-    cdef void _next(self, intp[::1] next_nodes, double[::1] next_proba):
+    cdef void _next(self, intp* next_nodes, double* next_proba, intp n_best) noexcept nogil:
         cdef intp L = self.stream_layer, r, w, m, p, u, n_union = 0, size = 0, arg, node, k
         cdef const Table* t = &self._layers[L - 1].table
-        cdef intp n_best = next_nodes.shape[0], n_kept = self.n_kept[L]
+        cdef intp n_kept = self.n_kept[L]
         cdef double total = 0.0, base = 0.0, best, unseen
         k = self._layers[L - 1].k
         for w in range(n_kept):

@@ -42,7 +42,6 @@ frame costs the same whatever came before. The per-frame loop is compiled
 """
 
 import numpy as np
-from sklearn.utils import Bunch
 
 from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decode import _log_normaliser
@@ -196,7 +195,7 @@ class OnlineMotionStream:
         return state
 
     def _make_kernel(self):
-        self._kernel = OnlineKernel(
+        kernel = OnlineKernel(
             self._gauss,
             self._layers,
             self._state,
@@ -206,6 +205,21 @@ class OnlineMotionStream:
             self.layer,
             self.lag + 1,
         )
+        kernel.answers(
+            self.model,
+            self._tree,
+            self.model.classes_,
+            self._class_of_graph,
+            self._ancestors,
+            self.n_best,
+            self.lag,
+            self._center,
+            self._scale,
+            not self._norms,
+        )
+        self._kernel = kernel
+        # the common case, one checked frame with no Python between (None: not that case)
+        self._step = kernel.step
 
     def reset(self):
         """Forget the frames: the next update starts a new clip."""
@@ -219,7 +233,7 @@ class OnlineMotionStream:
 
     def __getstate__(self):
         state = self.__dict__.copy()
-        del state["_kernel"]  # pointers into the arrays: made again on loading
+        del state["_kernel"], state["_step"]  # pointers into the arrays: made again on loading
         return state
 
     def __setstate__(self, state):
@@ -247,13 +261,22 @@ class OnlineMotionStream:
     def update(self, frames):
         """Take one frame ``(n_channels,)`` or a chunk ``(n_frames, n_channels)``; the state now.
 
+        A single float64 frame goes through the compiled kernel with no Python
+        in between (its shape, values and the model are still checked there);
+        anything else is converted and checked first, with the same answers.
+
         Returns
         -------
-        state : Bunch
-            The keys of :meth:`MotionStream.update`: ``frame``, ``node``,
-            ``nodes``, ``lagged_node``, ``proba``, ``label``, ``next_nodes``,
+        state : OnlineState
+            The keys of :meth:`MotionStream.update` (a mapping, like its
+            ``Bunch``, and attributes): ``frame``, ``node``, ``nodes``,
+            ``lagged_node``, ``proba``, ``label``, ``next_nodes``,
             ``next_proba``, here from the causal recursions (see the module).
+            The arrays are made on first access.
         """
+        state = self._step(frames)
+        if state is not None:
+            return state
         X = self._frames(frames)
         model = self.model
         if not self._norms:
@@ -294,22 +317,6 @@ class OnlineMotionStream:
 
     def state(self):
         """The answers for the frames seen so far (see :meth:`update`)."""
-        n_frames = int(self._state["n_frames"][0])
-        if n_frames == 0:
+        if not self._state["n_frames"][0]:
             raise ValueError("the stream has seen no frame yet; call update first.")
-        proba = np.empty(len(self.model.classes_))
-        next_nodes = np.empty(self.n_best, dtype=np.intp)
-        next_proba = np.empty(self.n_best)
-        node, lagged, label = self._kernel.summary(
-            self.lag, self._class_of_graph, proba, next_nodes, next_proba
-        )
-        return Bunch(
-            frame=n_frames - 1,
-            node=node,
-            nodes=self._ancestors[node].copy(),
-            lagged_node=lagged,
-            proba=proba,
-            label=self.model.classes_[label],
-            next_nodes=next_nodes,
-            next_proba=next_proba,
-        )
+        return self._kernel.result()

@@ -61,12 +61,20 @@ def _count(tree, clips, graph_of_clip, n_graphs, smoothing):
 
 
 def _first_call(est, X, y, classes):
-    """Build the database from the first batch, as ``fit`` does, keeping its frames and moments."""
-    est.fit(X, y)
-    clips = check_clips(X, estimator=est)
-    est._live = LiveDatabase.from_frames(est.tree_, [(c - est.center_) / est.scale_ for c in clips])
-    est._live.labels = list(_labels(y, len(clips)))
-    if classes is not None:
+    """Build the database from the first batch, as ``fit`` does, keeping its clips and moments."""
+    clips = check_clips(X, estimator=est, reset=True)
+    return _build(est, clips, list(_labels(y, len(clips))), classes)
+
+
+def _build(est, clips, labels, classes):
+    """The database ``fit`` builds from ``clips``; then the declared classes without clips."""
+    names = getattr(est, "feature_names_in_", None)  # the clips kept are arrays: keep the names
+    est.fit(clips, labels)
+    if names is not None:
+        est.feature_names_in_ = names
+    est._live = LiveDatabase.from_clips(est.tree_, clips, est.center_, est.scale_)
+    est._live.labels = labels
+    if classes is not None and len(np.setdiff1d(classes, est.classes_)):
         _regraph(est, _union(est.classes_, classes), None, [], [])
     return est
 
@@ -107,9 +115,9 @@ def _regraph(est, classes, tree_changed_clips, new_clips, new_y):
     est.graph_classes_ = graph_classes
 
 
-def partial_fit(est, X, y, classes, split_growth, rebuild_tol):
+def partial_fit(est, X, y, classes, split_growth, rebuild_growth, rebuild_tol):
     """See :meth:`MotionTreeHMM.partial_fit`."""
-    check_growth_params(split_growth, rebuild_tol)
+    check_growth_params(split_growth, rebuild_tol, rebuild_growth)
     if classes is not None and np.ndim(classes) != 1:
         raise ValueError(f"classes must be a 1-D array-like of labels; got {classes!r}.")
     if not hasattr(est, "tree_"):
@@ -119,11 +127,15 @@ def partial_fit(est, X, y, classes, split_growth, rebuild_tol):
     new_classes = _union(est.classes_, y, classes)
     live = getattr(est, "_live", None)
     if live is None or live.tree is not est.tree_:  # fit since: start from its tree
-        live = est._live = LiveDatabase.from_tree(est.tree_)
-    std = [(c - est.center_) / est.scale_ for c in clips]
+        live = est._live = LiveDatabase.from_tree(est.tree_, est.center_, est.scale_)
+    if live.root_due(sum(len(c) for c in clips), rebuild_growth):
+        # the whole database has grown rebuild_growth times: built again, as fit
+        # builds it from all clips so far (standardisation and temperature included)
+        return _build(est, live.clips + clips, live.labels + list(y), new_classes)
     changed = live.add(
-        std,
+        clips,
         split_growth=split_growth,
+        rebuild_growth=rebuild_growth,
         rebuild_tol=rebuild_tol,
         build_params={
             "max_depth": est.max_depth,
@@ -132,8 +144,12 @@ def partial_fit(est, X, y, classes, split_growth, rebuild_tol):
             "split": est.split,
         },
     )
-    if live.frames is not None:
+    if live.clips is not None:
         live.labels.extend(y)
     _set_layers(est, live.tree)
-    _regraph(est, new_classes, (live.frames, live.labels) if changed else None, std, y)
+    std = [(c - est.center_) / est.scale_ for c in clips]
+    recount = None
+    if changed:
+        recount = ([(c - est.center_) / est.scale_ for c in live.clips], live.labels)
+    _regraph(est, new_classes, recount, std, y)
     return est

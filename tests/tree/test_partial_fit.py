@@ -86,7 +86,14 @@ def test_clip_by_clip_equals_one_shot_without_splits(covariance_type):
     model = MotionTreeHMM(max_depth=4, min_samples_leaf=8, covariance_type=covariance_type)
     order = np.random.default_rng(1).permutation(len(CLIPS))
     first = list(order[:3])
-    grow(model, CLIPS, LABELS, [first] + [[i] for i in order[3:]], split_growth=None)
+    grow(
+        model,
+        CLIPS,
+        LABELS,
+        [first] + [[i] for i in order[3:]],
+        split_growth=None,
+        rebuild_growth=None,
+    )
     tree_of_first = (
         MotionTreeHMM(**model.get_params()).fit([CLIPS[i] for i in first], LABELS[first]).tree_
     )
@@ -108,7 +115,7 @@ def test_any_batching_gives_the_one_shot_statistics(order, cuts, kind):
         batches.append(list(order[start:stop]))
         start = stop
     model = MotionTreeHMM(max_depth=3, min_samples_leaf=8, covariance_type=kind)
-    grow(model, CLIPS, LABELS, batches, split_growth=None)
+    grow(model, CLIPS, LABELS, batches, split_growth=None, rebuild_growth=None)
     check_against_one_shot(model, [CLIPS[i] for i in order], LABELS[list(order)])
 
 
@@ -131,9 +138,9 @@ def test_moments_merge_exactly():
 def test_grown_leaves_split_by_the_build_rule():
     model = MotionTreeHMM(max_depth=5, min_samples_leaf=8)
     order = [0, 4] + [i for i in range(len(CLIPS)) if i not in (0, 4)]
-    grow(model, CLIPS, LABELS, [order[:2]], split_growth=1.5)
+    grow(model, CLIPS, LABELS, [order[:2]], split_growth=1.5, rebuild_growth=None)
     before = model.tree_
-    grow(model, CLIPS, LABELS, [order[2:]], split_growth=1.5)
+    grow(model, CLIPS, LABELS, [order[2:]], split_growth=1.5, rebuild_growth=None)
     tree = model.tree_
     assert tree.n_tree_nodes > before.n_tree_nodes  # leaves grew and split
     check_against_one_shot(model, [CLIPS[i] for i in order], LABELS[order])
@@ -155,7 +162,9 @@ def test_drifted_nodes_are_rebuilt_from_their_frames():
     model = MotionTreeHMM(max_depth=4, min_samples_leaf=8)
     walk = [i for i in range(len(CLIPS)) if LABELS[i] == "walk"]
     rest = [i for i in range(len(CLIPS)) if LABELS[i] != "walk"]
-    grow(model, CLIPS, LABELS, [walk, rest], split_growth=None, rebuild_tol=0.5)
+    grow(
+        model, CLIPS, LABELS, [walk, rest], split_growth=None, rebuild_growth=None, rebuild_tol=0.5
+    )
     tree = model.tree_
     # the root's mean moved far: the whole tree is the build's on all frames
     # (standardised as the first batch was)
@@ -202,7 +211,15 @@ def test_after_fit_diag_merges_and_full_raises():
 
 
 @pytest.mark.parametrize(
-    "bad", [{"split_growth": 1.0}, {"rebuild_tol": 0}, {"split_growth": "x"}, {"classes": "dance"}]
+    "bad",
+    [
+        {"split_growth": 1.0},
+        {"rebuild_tol": 0},
+        {"split_growth": "x"},
+        {"rebuild_growth": 0.5},
+        {"rebuild_growth": True},
+        {"classes": "dance"},
+    ],
 )
 def test_bad_growth_parameters(bad):
     with pytest.raises(ValueError, match=next(iter(bad))):
@@ -262,3 +279,86 @@ def test_novelty_follows_the_grown_database():
     typical = model.novelty_score(CLIPS)
     moved = model.novelty_score([c + 10 * model.scale_ for c in CLIPS])
     assert np.all(moved < typical)
+
+
+def test_a_doubled_database_is_rebuilt_as_fit_builds_it():
+    model = MotionTreeHMM(max_depth=4, min_samples_leaf=8)
+    order = list(np.random.default_rng(2).permutation(len(CLIPS)))
+    model.partial_fit([CLIPS[i] for i in order[:2]], LABELS[order[:2]], classes=["zzz"])
+    built, rebuilt_at = sum(len(CLIPS[i]) for i in order[:2]), []
+    for n in range(3, len(CLIPS) + 1):
+        center = model.center_
+        i = order[n - 1]
+        model.partial_fit([CLIPS[i]], LABELS[i : i + 1], split_growth=None)
+        total = sum(len(CLIPS[j]) for j in order[:n])
+        if total < 2 * built:  # not due: the standardisation stays
+            assert model.center_ is center
+            continue
+        built = total
+        rebuilt_at.append(n)
+        seen = [CLIPS[j] for j in order[:n]]
+        fitted = MotionTreeHMM(max_depth=4, min_samples_leaf=8).fit(seen, LABELS[order[:n]])
+        # the whole database is fit's on every clip so far (the declared class kept)
+        np.testing.assert_array_equal(model.center_, fitted.center_)
+        np.testing.assert_array_equal(model.tree_.threshold, fitted.tree_.threshold)
+        np.testing.assert_array_equal(model.tree_.covariance, fitted.tree_.covariance)
+        assert model.temperature_ == fitted.temperature_ and "zzz" in model.classes_
+        proba = model.predict_proba(CLIPS)[:, :-1]  # "zzz" (no clip) sorts last
+        np.testing.assert_allclose(
+            proba / proba.sum(axis=1, keepdims=True), fitted.predict_proba(CLIPS), rtol=1e-9
+        )
+    assert len(rebuilt_at) >= 2  # 2 clips first: the frames doubled twice on the way to 12
+    check_against_one_shot(model, [CLIPS[i] for i in order], LABELS[order])
+
+
+def test_a_doubled_subtree_is_rebuilt_by_the_build_rule():
+    model = MotionTreeHMM(max_depth=4, min_samples_leaf=8, standardize=False)
+    model.partial_fit(CLIPS, LABELS)
+    before = model.tree_
+    # a new clip near the frames of the root's smaller child: it doubles, the root does not
+    frames = np.concatenate(CLIPS)
+    child = min(before.left[0], before.right[0], key=lambda v: before.count[v])
+    near = frames[before.apply(frames, 1) == list(before.layers[1]).index(child)]
+    new = [near + np.random.default_rng(0).normal(0, 1e-3, near.shape)]
+    model.partial_fit(new, ["new"], split_growth=None)
+    tree = model.tree_
+    assert tree.count[0] < 2 * before.count[0] and tree.threshold[0] == before.threshold[0]
+    node = tree.left[0] if child == before.left[0] else tree.right[0]
+    assert tree.count[node] == 2 * before.count[child]
+    everything = np.concatenate(CLIPS + new)
+    paths = list(tree.iter_apply(everything))
+    # every split under the rebuilt child is the build's on its frames now
+    inside = [node]
+    for v in inside:
+        if tree.left[v] < 0:
+            continue
+        inside += [tree.left[v], tree.right[v]]
+        mine = everything[tree.layers[tree.depth[v]][paths[tree.depth[v]]] == v]
+        alone = MotionTree.build(mine, max_depth=1, min_samples_leaf=8, split=model.split)
+        np.testing.assert_allclose(alone.threshold[0], tree.threshold[v], rtol=1e-9)
+    assert len(inside) > 1 and "new" in model.classes_
+    check_against_one_shot(model, CLIPS + new, list(LABELS) + ["new"])
+
+
+def test_a_rebuilt_database_keeps_the_channel_names_of_dataframes():
+    import warnings
+
+    import pandas as pd
+
+    def frame(indices):
+        parts = {i: pd.DataFrame(CLIPS[i], columns=[f"ch{j}" for j in range(12)]) for i in indices}
+        return pd.concat(parts, names=["clip", "frame"])
+
+    model = MotionTreeHMM(max_depth=3, min_samples_leaf=8).partial_fit(
+        frame([0, 4]), LABELS[[0, 4]]
+    )
+    center = model.center_
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "fitted without feature names" on the way
+        for i in (1, 2, 3, 5):
+            model.partial_fit(frame([i]), LABELS[[i]])
+        assert model.center_ is not center  # the frames doubled: rebuilt on the way
+        assert list(model.feature_names_in_) == [f"ch{j}" for j in range(12)]
+        np.testing.assert_array_equal(model.predict(frame(range(12))), model.predict(CLIPS))
+    with pytest.raises(ValueError, match="ch"):
+        model.partial_fit(frame([6]).rename(columns={"ch0": "other"}), LABELS[[6]])

@@ -357,3 +357,66 @@ def test_online_is_the_default_and_refuses_a_model_fit_again():
     model.partial_fit(CLIPS[6:], LABELS[6:])
     with pytest.raises(ValueError, match="start a new stream"):
         stream.update(CLIPS[0][5:10])
+    with pytest.raises(ValueError, match="start a new stream"):
+        stream.update(CLIPS[0][5])  # a single frame too (the compiled path)
+
+
+def test_online_single_frames_take_the_compiled_path_with_the_same_answers():
+    model, clip = MODELS["class"], CLIPS[4][:40]
+    fast, general = model.stream(lag=2), model.stream(lag=2)
+    for frame in clip:
+        # a 1-D float64 frame goes through the kernel's step; a list through the general path
+        assert fast._step(frame.copy()) is not None
+        fast_state = fast.state()
+        general_state = general.update(frame.tolist())
+        for key in fast_state:
+            np.testing.assert_array_equal(fast_state[key], general_state[key])
+    # other dtypes, strides and shapes: the general path, the same answers
+    for frames in (clip[:5].astype(np.float32), clip[:5, ::-1][:, ::-1], clip[:1]):
+        a = model.stream().update(frames)
+        b = model.stream().update(np.ascontiguousarray(frames, dtype=np.float64))
+        for key in a:
+            np.testing.assert_array_equal(a[key], b[key])
+    strided = np.asfortranarray(clip[:3])[1]  # a non-contiguous single frame
+    assert not strided.flags.c_contiguous
+    assert model.stream().update(strided).node == model.stream().update(clip[1]).node
+
+
+def test_online_single_frame_errors_leave_the_stream_unchanged():
+    model, clip = MODELS["class"], CLIPS[0]
+    stream = model.stream()
+    stream.update(clip[0])
+    for value, name in ((np.nan, "nan"), (-np.inf, "-inf")):
+        frame = clip[1].copy()
+        frame[7] = value
+        with pytest.raises(ValueError, match=f"frame 1 .* channel 7 is {name}"):
+            stream.update(frame)
+    with pytest.raises(ValueError, match=f"{model.n_features_in_} channels.*got shape"):
+        stream.update(clip[1][:-1])
+    with pytest.raises(ValueError, match=f"{model.n_features_in_} channels.*got shape"):
+        stream.update(np.zeros((2, 3, model.n_features_in_)))
+    assert stream.n_frames == 1
+    after = stream.update(clip[1])
+    fresh = model.stream().update(clip[:2])
+    for key in fresh:
+        np.testing.assert_array_equal(after[key], fresh[key])
+
+
+def test_online_state_is_a_fixed_mapping_that_pickles():
+    model, clip = MODELS["class"], CLIPS[1]
+    stream = model.stream(lag=1)
+    first = stream.update(clip[0])
+    expected = {key: np.copy(first[key]) for key in first}
+    for frame in clip[1:10]:
+        stream.update(frame)  # later updates do not change an earlier state (read lazily)
+    assert first.keys() == tuple(expected) and len(first) == 8 and "proba" in first
+    for key in expected:
+        np.testing.assert_array_equal(first[key], expected[key])
+        np.testing.assert_array_equal(getattr(first, key), expected[key])
+    assert dict(first.items()).keys() == expected.keys() and first.get("nope", 3) == 3
+    with pytest.raises(KeyError):
+        first["nope"]
+    again = pickle.loads(pickle.dumps(first))
+    for key in expected:
+        np.testing.assert_array_equal(again[key], expected[key])
+    assert "label=" in repr(again) and first.frame == 0 and first.lagged_node == -1
