@@ -29,4 +29,11 @@ online = Extension(
     ],
     extra_compile_args=["-O3", "-fopenmp-simd"],
 )
-setup(ext_modules=cythonize([beam, online]))
+# Leading eigenpairs of each clip's Gram matrix (decomposition/_clip_svd.py): SciPy's
+# BLAS/LAPACK through the pointers SciPy exports, so no build-time SciPy.
+leading = Extension(
+    "skmotion.decomposition._leading",
+    ["skmotion/decomposition/_leading.pyx"],
+    extra_compile_args=["-O3"],
+)
+setup(ext_modules=cythonize([beam, online, leading]))

@@ -14,6 +14,7 @@ import numpy as np
 # threadpoolctl comes with scikit-learn (one of its own dependencies).
 from threadpoolctl import ThreadpoolController
 
+from skmotion.decomposition._leading import leading_spectra
 from skmotion.utils._parallel import parallel_map
 
 __all__ = ["clip_spectra", "small_blas"]
@@ -77,14 +78,6 @@ def _leading_eigh(grams, n_vectors):
     if 2 * block >= d:  # small matrices: the full decomposition costs no more
         values, vectors = np.linalg.eigh(grams)
         return values[:, ::-1][:, :n_vectors], vectors[:, :, ::-1][:, :, :n_vectors]
-    if n_vectors == 1:
-        start = grams.sum(axis=2, keepdims=True) + grams[:, :, :1]
-        start /= np.maximum(np.linalg.norm(start, axis=1, keepdims=True), np.finfo(float).tiny)
-        values, vectors, todo = _leading_pair(lambda rows, x: grams[rows] @ x, start)
-        if len(todo):
-            exact_values, exact_vectors = np.linalg.eigh(grams[todo])
-            values[todo], vectors[todo] = exact_values[:, -1:], exact_vectors[:, :, -1:]
-        return values, vectors
     start = np.random.default_rng(0).standard_normal((d, block))  # fixed: reproducible
     basis = np.linalg.qr(grams @ start)[0]
     values = np.zeros((m, n_vectors))
@@ -114,36 +107,9 @@ def _leading_eigh(grams, n_vectors):
     return values, vectors
 
 
-def _leading_pair(apply, start):
-    """The leading eigenpair of stacked symmetric PSD matrices ``G`` by power iteration.
-
-    ``apply(rows, x)`` is ``G[rows] @ x``. (Steps ``A^T (A x)`` on the clips,
-    without forming ``G``, were measured slower: numpy's stacked matrix-vector
-    products do not reach BLAS speed.) Uncentred motion clips have a
-    dominant first singular value (the mean posture), so plain power steps (a
-    product and a normalisation, no QR) converge in a few steps; the residual
-    is checked as in :func:`_leading_eigh`, and ``None`` marks the rows that did
-    not converge. Returns ``(values (m, 1), vectors (m, d, 1), unconverged rows)``.
-    """
-    m, d, _ = start.shape
-    values, vectors = np.zeros((m, 1)), np.zeros((m, d, 1))
-    todo, vector = np.arange(m), start
-    for step in range(1, 4 * _MAX_STEPS + 1):
-        product = apply(todo, vector)
-        if step % _CHECK == 0:
-            value = (vector * product).sum(axis=1)  # the Rayleigh quotient of unit vectors
-            residual = np.linalg.norm(product - vector * value[:, None, :], axis=1)
-            done = (residual[:, 0] <= _TOLERANCE * np.abs(value[:, 0])) & (step > 1)
-            values[todo[done]], vectors[todo[done]] = value[done], vector[done]
-            todo, product = todo[~done], product[~done]
-            if not len(todo):
-                break
-        norms = np.linalg.norm(product, axis=1, keepdims=True)
-        vector = product / np.maximum(norms, np.finfo(float).tiny)
-    return values, vectors, todo
-
-
 def _spectra_of_chunk(chunk, n_vectors, method):
+    if method == "iterative" and n_vectors == 1:
+        return _first_pairs(chunk)
     n = chunk[0].shape[1]
     eigenvalues = np.zeros((len(chunk), n))
     vectors = np.zeros((len(chunk), n, n_vectors))
@@ -171,6 +137,26 @@ def _spectra_of_chunk(chunk, n_vectors, method):
             vecs = np.divide(vecs, norms, out=np.zeros_like(vecs), where=norms > 0)
         eigenvalues[rows, : values.shape[1]] = values
         vectors[rows, :, : vecs.shape[2]] = vecs
+    return _zero_beyond_rank(eigenvalues, vectors)
+
+
+def _first_pairs(chunk):
+    """The leading pair of each clip by the compiled kernel (any lengths, one call).
+
+    Power steps on the smaller Gram matrix, checked as in :func:`_leading_eigh`
+    (LAPACK's ``dsyevr`` for a clip not converged), without numpy's per-call
+    cost on small stacked matrices: the tree's features of a query.
+    """
+    n = chunk[0].shape[1]
+    clips = [np.ascontiguousarray(c, dtype=np.float64) for c in chunk]
+    values, vectors = leading_spectra(clips, 1, _TOLERANCE, _CHECK, 4 * _MAX_STEPS)
+    eigenvalues = np.zeros((len(chunk), n))
+    eigenvalues[:, :1] = values
+    return _zero_beyond_rank(eigenvalues, vectors)
+
+
+def _zero_beyond_rank(eigenvalues, vectors):
+    n, n_vectors = vectors.shape[1:]
     eigenvalues = np.clip(eigenvalues, 0.0, None)
     # Directions beyond a clip's rank are undefined: make them zero vectors, so
     # that every caller treats them the same whichever route computed them.
@@ -192,8 +178,9 @@ def clip_spectra(clips, n_vectors, *, method="exact", n_jobs=None):
     method : {"exact", "iterative"}, default="exact"
         ``"exact"``: a full batched ``eigh`` of each Gram matrix, all eigenvalues.
         ``"iterative"``: subspace iteration for the ``n_vectors`` leading pairs
-        only, each within ``1e-9 * lambda_1`` in residual (a full ``eigh``
-        otherwise); the eigenvalues beyond ``n_vectors`` are then returned as 0.
+        only (power steps in a compiled loop for one pair), each within
+        ``1e-9 * lambda_1`` in residual (a full ``eigh`` otherwise); the
+        eigenvalues beyond ``n_vectors`` are then returned as 0.
     n_jobs : int, default=None
         Number of jobs over chunks of clips; results do not depend on it.
 
