@@ -62,54 +62,9 @@ def _unit_scale(clip):
     return clip / peak if peak > 0 else clip
 
 
-def _leading_eigh(grams, n_vectors):
-    """Leading eigenpairs of stacked symmetric matrices by subspace iteration.
-
-    A block of ``n_vectors + 4`` vectors is multiplied by the matrices and
-    re-orthonormalised (one batched QR) a few times, then a Rayleigh-Ritz step
-    (a batched eigh of ``block x block`` matrices) gives the pairs. Every
-    ``_CHECK`` steps the residuals ``|G v - lambda v|`` are checked against
-    ``_TOLERANCE * lambda_1``; matrices not converged after ``_MAX_STEPS``
-    (close eigenvalues, slow convergence) get a full ``eigh``, so the answer is
-    always within the tolerance. Returns values (decreasing) and vectors.
-    """
-    m, d, _ = grams.shape
-    block = min(d, n_vectors + 4)
-    if 2 * block >= d:  # small matrices: the full decomposition costs no more
-        values, vectors = np.linalg.eigh(grams)
-        return values[:, ::-1][:, :n_vectors], vectors[:, :, ::-1][:, :, :n_vectors]
-    start = np.random.default_rng(0).standard_normal((d, block))  # fixed: reproducible
-    basis = np.linalg.qr(grams @ start)[0]
-    values = np.zeros((m, n_vectors))
-    vectors = np.zeros((m, d, n_vectors))
-    todo = np.arange(m)
-    for step in range(2, _MAX_STEPS + 1, 2):
-        # Two products per orthonormalisation: the QR costs more than a product,
-        # and the Gram matrices of unit-scaled clips keep G^2 X well within range.
-        active = grams[todo]
-        basis = np.linalg.qr(active @ (active @ basis))[0]
-        if step % _CHECK and step < _MAX_STEPS:
-            continue
-        product = active @ basis
-        ritz, rotation = np.linalg.eigh(np.swapaxes(basis, 1, 2) @ product)
-        rotation = rotation[:, :, ::-1][:, :, :n_vectors]
-        ritz = ritz[:, ::-1][:, :n_vectors]
-        candidate = basis @ rotation
-        residual = np.linalg.norm(product @ rotation - candidate * ritz[:, None, :], axis=1)
-        done = (residual <= _TOLERANCE * np.abs(ritz[:, :1])).all(axis=1)
-        values[todo[done]], vectors[todo[done]] = ritz[done], candidate[done]
-        todo, basis = todo[~done], basis[~done]
-        if not len(todo):
-            return values, vectors
-    exact_values, exact_vectors = np.linalg.eigh(grams[todo])
-    values[todo] = exact_values[:, ::-1][:, :n_vectors]
-    vectors[todo] = exact_vectors[:, :, ::-1][:, :, :n_vectors]
-    return values, vectors
-
-
 def _spectra_of_chunk(chunk, n_vectors, method):
-    if method == "iterative" and n_vectors == 1:
-        return _first_pairs(chunk)
+    if method == "iterative":
+        return _leading_pairs(chunk, n_vectors)
     n = chunk[0].shape[1]
     eigenvalues = np.zeros((len(chunk), n))
     vectors = np.zeros((len(chunk), n, n_vectors))
@@ -125,11 +80,8 @@ def _spectra_of_chunk(chunk, n_vectors, method):
         clips = clips / np.where(peak > 0, peak, 1.0)  # see _unit_scale
         tall = length >= n
         grams = np.swapaxes(clips, 1, 2) @ clips if tall else clips @ np.swapaxes(clips, 1, 2)
-        if method == "iterative":
-            values, vecs = _leading_eigh(grams, min(n_vectors, grams.shape[1]))
-        else:
-            values, vecs = np.linalg.eigh(grams)
-            values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
+        values, vecs = np.linalg.eigh(grams)
+        values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
         if not tall:
             # Right singular vectors from the left ones: v = A^T w / |A^T w|.
             vecs = np.swapaxes(clips, 1, 2) @ vecs
@@ -140,18 +92,22 @@ def _spectra_of_chunk(chunk, n_vectors, method):
     return _zero_beyond_rank(eigenvalues, vectors)
 
 
-def _first_pairs(chunk):
-    """The leading pair of each clip by the compiled kernel (any lengths, one call).
+def _leading_pairs(chunk, n_vectors):
+    """The leading pairs of each clip by the compiled kernel (any lengths, one call).
 
-    Power steps on the smaller Gram matrix, checked as in :func:`_leading_eigh`
-    (LAPACK's ``dsyevr`` for a clip not converged), without numpy's per-call
-    cost on small stacked matrices: the tree's features of a query.
+    Power steps (one pair) or subspace iteration (a block of ``n_vectors + 4``,
+    two products per QR, a Rayleigh-Ritz step every ``_CHECK`` steps) on the
+    smaller Gram matrix, each pair's residual ``|G v - lambda v|`` within
+    ``_TOLERANCE * lambda_1``, and LAPACK's ``dsyevr`` for the clips not
+    converged after ``_MAX_STEPS`` (or whose matrix is small enough that the
+    full problem costs no more). Compiled, because numpy's per-call cost on
+    small stacked matrices was most of a query's cost.
     """
     n = chunk[0].shape[1]
     clips = [np.ascontiguousarray(c, dtype=np.float64) for c in chunk]
-    values, vectors = leading_spectra(clips, 1, _TOLERANCE, _CHECK, 4 * _MAX_STEPS)
+    values, vectors = leading_spectra(clips, n_vectors, _TOLERANCE, _CHECK, _MAX_STEPS)
     eigenvalues = np.zeros((len(chunk), n))
-    eigenvalues[:, :1] = values
+    eigenvalues[:, :n_vectors] = values
     return _zero_beyond_rank(eigenvalues, vectors)
 
 
@@ -177,10 +133,11 @@ def clip_spectra(clips, n_vectors, *, method="exact", n_jobs=None):
         How many leading right singular vectors to return (at most ``n_channels``).
     method : {"exact", "iterative"}, default="exact"
         ``"exact"``: a full batched ``eigh`` of each Gram matrix, all eigenvalues.
-        ``"iterative"``: subspace iteration for the ``n_vectors`` leading pairs
-        only (power steps in a compiled loop for one pair), each within
-        ``1e-9 * lambda_1`` in residual (a full ``eigh`` otherwise); the
-        eigenvalues beyond ``n_vectors`` are then returned as 0.
+        ``"iterative"``: the ``n_vectors`` leading pairs only, by a compiled
+        loop over the clips (power steps for one pair, subspace iteration for
+        several), each within ``1e-9 * lambda_1`` in residual (LAPACK's
+        ``dsyevr`` otherwise); the eigenvalues beyond ``n_vectors`` are then
+        returned as 0.
     n_jobs : int, default=None
         Number of jobs over chunks of clips; results do not depend on it.
 

@@ -10,9 +10,13 @@ Python between (and without the GIL):
    (frames x frames) for a clip with fewer frames than channels, with one
    ``dsyrk``;
 3. one leading pair: power steps (``dsymv``), the residual ``|G v - lambda v|``
-   checked every ``check`` steps against ``tolerance * lambda``, and LAPACK's
-   ``dsyevr`` for the top pair when not converged after ``max_steps``; several
-   pairs: ``dsyevr`` for exactly those (``range="I"``, LAPACK's accuracy);
+   checked every ``check`` steps against ``tolerance * lambda``; several pairs:
+   subspace iteration on a block of ``n_pairs + 4`` vectors (two ``dsymm``
+   products per Householder QR, a Rayleigh-Ritz step by Jacobi rotations every
+   ``check`` steps, every pair's residual within ``tolerance * lambda_1``);
+   LAPACK's ``dsyevr`` for exactly the pairs asked (``range="I"``) when these
+   have not converged after ``max_steps``, or when the matrix is smaller than
+   twice the block;
 4. for a short clip, the right singular vectors from the left ones,
    ``v = A^T w / |A^T w|`` (``dgemv``).
 
@@ -26,7 +30,7 @@ this loop does not have.
 import numpy as np
 
 from cpython.pycapsule cimport PyCapsule_GetName, PyCapsule_GetPointer
-from libc.math cimport fabs, sqrt
+from libc.math cimport INFINITY, fabs, sqrt
 from libc.stdlib cimport free, malloc
 
 ctypedef void (*dsyrk_t)(char*, char*, int*, int*, double*, double*, int*, double*,
@@ -39,7 +43,19 @@ ctypedef void (*dsyevr_t)(char*, char*, char*, int*, double*, int*, double*, dou
                           int*, double*, int*, double*, double*, int*, int*, double*, int*,
                           int*, int*, int*) noexcept nogil
 
+ctypedef void (*dsymm_t)(char*, char*, int*, int*, double*, double*, int*, double*, int*,
+                         double*, double*, int*) noexcept nogil
+ctypedef void (*dgeqrf_t)(int*, int*, double*, int*, double*, double*, int*, int*) noexcept nogil
+ctypedef void (*dorgqr_t)(int*, int*, int*, double*, int*, double*, double*, int*,
+                          int*) noexcept nogil
+ctypedef void (*dgemm_t)(char*, char*, int*, int*, int*, double*, double*, int*, double*, int*,
+                         double*, double*, int*) noexcept nogil
+
 cdef dsyrk_t _dsyrk
+cdef dgemm_t _dgemm
+cdef dsymm_t _dsymm
+cdef dgeqrf_t _dgeqrf
+cdef dorgqr_t _dorgqr
 cdef dsymv_t _dsymv
 cdef dgemv_t _dgemv
 cdef dsyevr_t _dsyevr
@@ -51,13 +67,17 @@ cdef void* _pointer(module, str name) except NULL:
 
 
 def _load():
-    global _dsyrk, _dsymv, _dgemv, _dsyevr
+    global _dsyrk, _dsymv, _dgemv, _dsyevr, _dgemm, _dsymm, _dgeqrf, _dorgqr
     from scipy.linalg import cython_blas, cython_lapack
 
     _dsyrk = <dsyrk_t>_pointer(cython_blas, "dsyrk")
     _dsymv = <dsymv_t>_pointer(cython_blas, "dsymv")
     _dgemv = <dgemv_t>_pointer(cython_blas, "dgemv")
     _dsyevr = <dsyevr_t>_pointer(cython_lapack, "dsyevr")
+    _dgemm = <dgemm_t>_pointer(cython_blas, "dgemm")
+    _dsymm = <dsymm_t>_pointer(cython_blas, "dsymm")
+    _dgeqrf = <dgeqrf_t>_pointer(cython_lapack, "dgeqrf")
+    _dorgqr = <dorgqr_t>_pointer(cython_lapack, "dorgqr")
 
 
 _load()
@@ -138,10 +158,186 @@ cdef bint _power(int n, double* gram, double* x, double* y, double* value,
     return False
 
 
+ctypedef struct Space:
+    # Scratch for one clip at a time: sizes for the largest clip of the call.
+    double* scaled   # the unit-scaled clip
+    double* gram     # the Gram matrix (lower triangle, column-major)
+    double* pairs    # the pairs found, n x n_pairs column-major, then 2 work vectors
+    double* x        # subspace iteration: basis, products (n x block each) ...
+    double* y
+    double* p
+    double* h        # ... block x block Rayleigh quotient, rotation, Ritz values
+    double* r
+    double* ritz
+    double* tau      # Householder scalars of the QR
+    double* qwork
+    int lqwork
+    double* work     # dsyevr
+    int lwork
+    int* iwork
+    int liwork
+    int* support
+    const double* start  # the fixed start block, n_max x block_max row-major
+    int start_cols
+
+
+cdef int _orthonormalise(int n, int b, double* x, Space* s) noexcept nogil:
+    """Replace the ``n x b`` columns of ``x`` by an orthonormal basis of their span (QR).
+
+    Householder (LAPACK): orthonormal to rounding however close the columns are
+    (as after ``G^2`` products) and whatever the clip's rank. Returns its info.
+    """
+    cdef int info = 0
+    _dgeqrf(&n, &b, x, &n, s.tau, s.qwork, &s.lqwork, &info)
+    if info == 0:
+        _dorgqr(&n, &b, &b, x, &n, s.tau, s.qwork, &s.lqwork, &info)
+    return info
+
+
+cdef void _symmetric_product(int n, int b, double* g, double* x, double* y) noexcept nogil:
+    """``y = G x`` for ``n x n`` symmetric ``g`` (lower triangle) and ``n x b`` ``x``."""
+    cdef char left = b"L", lower = b"L"
+    cdef double one = 1.0, zero = 0.0
+    _dsymm(&left, &lower, &n, &b, &one, g, &n, x, &n, &zero, y, &n)
+
+
+cdef void _jacobi(int b, int n_pairs, double* a, double* v, double* values,
+                  double* vectors) noexcept nogil:
+    """The ``n_pairs`` largest eigenpairs of the small symmetric ``b x b`` matrix ``a``.
+
+    Cyclic Jacobi rotations (Rutishauser's formulas) until the off-diagonal
+    mass is below rounding: accurate to the last digits, and for the Ritz
+    problems of a few vectors far cheaper than a LAPACK call (whose setup
+    dominates at this size). ``a`` (full, column-major) is destroyed; ``v``
+    is ``b x b`` scratch; ``vectors`` gets ``b x n_pairs`` column-major.
+    """
+    cdef int i, j, p, q, sweep, best
+    cdef double off, scale, theta, t, c, sn, tau, app, aqq, apq, x, y
+    for i in range(b * b):
+        v[i] = 0.0
+    for i in range(b):
+        v[i * b + i] = 1.0
+    for sweep in range(100):
+        off = 0.0
+        scale = 0.0
+        for q in range(b):
+            for p in range(b):
+                if p < q:
+                    off += a[q * b + p] * a[q * b + p]
+                elif p == q:
+                    scale += a[p * b + p] * a[p * b + p]
+        if off <= 1e-34 * (scale + off) or off == 0.0:
+            break
+        for p in range(b - 1):
+            for q in range(p + 1, b):
+                apq = a[q * b + p]
+                if apq == 0.0:
+                    continue
+                app, aqq = a[p * b + p], a[q * b + q]
+                theta = (aqq - app) / (2.0 * apq)
+                t = 1.0 / (fabs(theta) + sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+                c = 1.0 / sqrt(t * t + 1.0)
+                sn = t * c
+                tau = sn / (1.0 + c)
+                for i in range(b):  # columns p and q, then rows p and q (symmetric)
+                    x, y = a[p * b + i], a[q * b + i]
+                    a[p * b + i] = x - sn * (y + tau * x)
+                    a[q * b + i] = y + sn * (x - tau * y)
+                for i in range(b):
+                    x, y = a[i * b + p], a[i * b + q]
+                    a[i * b + p] = x - sn * (y + tau * x)
+                    a[i * b + q] = y + sn * (x - tau * y)
+                for i in range(b):
+                    x, y = v[p * b + i], v[q * b + i]
+                    v[p * b + i] = x - sn * (y + tau * x)
+                    v[q * b + i] = y + sn * (x - tau * y)
+    # The n_pairs largest, decreasing (selection: b is small); the diagonal
+    # entries taken are marked by -inf.
+    for j in range(n_pairs):
+        best = -1
+        for i in range(b):
+            if a[i * b + i] != -INFINITY and (best < 0 or a[i * b + i] > a[best * b + best]):
+                best = i
+        values[j] = a[best * b + best]
+        a[best * b + best] = -INFINITY
+        for i in range(b):
+            vectors[j * b + i] = v[best * b + i]
+
+
+cdef bint _subspace(int n, int n_pairs, int b, Space* s, double* values, double tolerance,
+                    int check, int max_steps) noexcept nogil:
+    """Leading pairs by subspace iteration (as the numpy route did), into values, s.pairs.
+
+    A block of ``b`` vectors: two products by ``G`` per QR, and every
+    ``check`` steps a Rayleigh-Ritz step whose residuals ``|G v - lambda v|``
+    must be within ``tolerance * lambda_1``. Returns whether they were.
+    """
+    cdef char no = b"N", yes = b"T"
+    cdef double one = 1.0, zero = 0.0, residual, bound
+    cdef int i, j, step
+    cdef bint ok
+    for j in range(b):
+        for i in range(n):
+            s.y[i + j * n] = s.start[i * s.start_cols + j]
+    _symmetric_product(n, b, s.gram, s.y, s.x)
+    if _orthonormalise(n, b, s.x, s) != 0:
+        return False
+    for step in range(2, max_steps + 1, 2):
+        # Two products per orthonormalisation, which costs more than a product;
+        # the Gram matrix of a unit-scaled clip keeps G^2 X well within range.
+        _symmetric_product(n, b, s.gram, s.x, s.y)
+        _symmetric_product(n, b, s.gram, s.y, s.x)
+        if _orthonormalise(n, b, s.x, s) != 0:
+            return False
+        if step % check and step < max_steps:
+            continue
+        _symmetric_product(n, b, s.gram, s.x, s.p)
+        _dgemm(&yes, &no, &b, &b, &n, &one, s.x, &n, s.p, &n, &zero, s.h, &b)
+        _jacobi(b, n_pairs, s.h, s.work, s.ritz, s.r)
+        # Candidates V = X R (into pairs) and G V = P R (into y).
+        _dgemm(&no, &no, &n, &n_pairs, &b, &one, s.x, &n, s.r, &b, &zero, s.pairs, &n)
+        _dgemm(&no, &no, &n, &n_pairs, &b, &one, s.p, &n, s.r, &b, &zero, s.y, &n)
+        bound = tolerance * fabs(s.ritz[0])
+        ok = True
+        for j in range(n_pairs):
+            residual = 0.0
+            for i in range(n):
+                residual += (s.y[i + j * n] - s.ritz[j] * s.pairs[i + j * n]) ** 2
+            if sqrt(residual) > bound:
+                ok = False
+                break
+        if ok:
+            for j in range(n_pairs):
+                values[j] = s.ritz[j]
+            return True
+    return False
+
+
+cdef int _pairs_of_gram(int n, int n_pairs, Space* s, double* values, double tolerance,
+                        int check, int max_steps) noexcept nogil:
+    """The ``n_pairs`` leading pairs of ``s.gram`` into ``values`` and ``s.pairs``.
+
+    One pair: power steps; several: subspace iteration with a block of
+    ``n_pairs + 4`` when that is under half the size (else the full problem
+    costs no more); LAPACK's dsyevr whenever these do not converge. Returns
+    LAPACK's info.
+    """
+    cdef int b = min(n, n_pairs + 4)
+    if n_pairs == 1:
+        if _power(n, s.gram, s.pairs, s.pairs + n, values, tolerance, check, 4 * max_steps):
+            return 0
+    elif 2 * b < n:
+        if _subspace(n, n_pairs, b, s, values, tolerance, check, max_steps):
+            return 0
+    return _top_pairs(n, n_pairs, s.gram, values, s.pairs, s.work, s.lwork, s.iwork, s.liwork,
+                      s.support)
+
+
 cdef int _one_clip(const double* clip, int n_frames, int n_channels, int n_vectors,
-                   double* values, double* vectors, double* scaled, double* gram,
-                   double* scratch, double* work, int lwork, int* iwork, int liwork,
-                   int* support, double tolerance, int check, int max_steps) noexcept nogil:
+                   double* values, double* vectors, Space* s, double tolerance, int check,
+                   int max_steps) noexcept nogil:
     """Leading eigenpairs of one clip into ``values`` (n_vectors) and ``vectors``.
 
     ``vectors`` is the clip's ``n_channels x n_vectors`` block, row-major (as
@@ -158,35 +354,29 @@ cdef int _one_clip(const double* clip, int n_frames, int n_channels, int n_vecto
     if peak == 0.0:
         return 0  # an all-zero clip: zero values and vectors
     for i in range(size):
-        scaled[i] = clip[i] / peak
+        s.scaled[i] = clip[i] / peak
     # The row-major clip (frames x channels) is the column-major B = A^T
     # (channels x frames): A^T A = B B^T, A A^T = B^T B.
     n = n_channels if tall else n_frames
     if tall:
-        _dsyrk(&uplo, &no, &n, &n_frames, &alpha, scaled, &n_channels, &beta, gram, &n)
+        _dsyrk(&uplo, &no, &n, &n_frames, &alpha, s.scaled, &n_channels, &beta, s.gram, &n)
     else:
-        _dsyrk(&uplo, &yes, &n, &n_channels, &alpha, scaled, &n_channels, &beta, gram, &n)
+        _dsyrk(&uplo, &yes, &n, &n_channels, &alpha, s.scaled, &n_channels, &beta, s.gram, &n)
     n_pairs = n_vectors if n_vectors < n else n
-    # scratch: n_pairs column-major vectors of length n, then two work vectors.
-    if n_pairs == 1 and _power(n, gram, scratch, scratch + n, values, tolerance, check,
-                               max_steps):
-        pass
-    else:
-        info = _top_pairs(n, n_pairs, gram, values, scratch, work, lwork, iwork, liwork,
-                          support)
+    info = _pairs_of_gram(n, n_pairs, s, values, tolerance, check, max_steps)
     for j in range(n_pairs):
         if tall:
             for i in range(n_channels):
-                vectors[i * n_vectors + j] = scratch[j * n + i]
-        else:  # v = A^T w = B w, then unit norm
-            _dgemv(&no, &n_channels, &n_frames, &alpha, scaled, &n_channels,
-                   scratch + j * n, &one, &beta, gram, &one)
+                vectors[i * n_vectors + j] = s.pairs[j * n + i]
+        else:  # v = A^T w = B w (into gram, no longer needed), then unit norm
+            _dgemv(&no, &n_channels, &n_frames, &alpha, s.scaled, &n_channels,
+                   s.pairs + j * n, &one, &beta, s.gram, &one)
             norm = 0.0
             for i in range(n_channels):
-                norm += gram[i] * gram[i]
+                norm += s.gram[i] * s.gram[i]
             norm = sqrt(norm)
             for i in range(n_channels):
-                vectors[i * n_vectors + j] = gram[i] / norm if norm > 0.0 else 0.0
+                vectors[i * n_vectors + j] = s.gram[i] / norm if norm > 0.0 else 0.0
     return info
 
 
@@ -200,8 +390,9 @@ def leading_spectra(list clips, int n_vectors, double tolerance, int check, int 
         Pairs per clip (at most ``n_channels``); a clip with fewer frames gets
         ``n_frames`` of them and zeros after.
     tolerance, check, max_steps : float, int, int
-        Power steps (one pair): the residual bound relative to the eigenvalue,
-        the steps between checks, and the steps before LAPACK takes over.
+        The residual bound relative to the largest eigenvalue, the steps
+        between checks, and the steps of subspace iteration (four times as
+        many power steps for one pair) before LAPACK takes over.
 
     Returns
     -------
@@ -215,54 +406,69 @@ def leading_spectra(list clips, int n_vectors, double tolerance, int check, int 
     vectors_out = np.zeros((m, n_channels, n_vectors))
     cdef double[:, ::1] values = values_out
     cdef double[:, :, ::1] vectors = vectors_out
-    cdef const double** pointers = <const double**>malloc(max(m, 1) * sizeof(double*))
-    cdef int* frames = <int*>malloc(max(m, 1) * sizeof(int))
     cdef const double[:, ::1] view
-    cdef int longest = 0, n_max, lwork, liwork, failed = -1
-    try:
-        for c in range(m):
-            view = clips[c]
-            if view.shape[1] != n_channels:
-                raise ValueError(f"clip {c} has {view.shape[1]} channels, not {n_channels}.")
-            pointers[c] = &view[0, 0] if view.shape[0] else NULL
-            frames[c] = view.shape[0]
-            longest = max(longest, frames[c])
-        n_max = max(1, min(longest, n_channels))
-        lwork, liwork = 26 * n_max, 10 * n_max
-        failed = _run(m, pointers, frames, n_channels, n_vectors, &values[0, 0],
-                      &vectors[0, 0, 0], longest, n_max, lwork, liwork, tolerance, check,
-                      max_steps)
-    finally:
-        free(pointers)
-        free(frames)
+    cdef int longest = 0, n_max, block
+    frames_out = np.zeros(max(m, 1), dtype=np.intc)
+    cdef int[::1] frames = frames_out
+    for c in range(m):
+        view = clips[c]
+        if view.shape[1] != n_channels:
+            raise ValueError(f"clip {c} has {view.shape[1]} channels, not {n_channels}.")
+        frames[c] = view.shape[0]
+        longest = max(longest, frames[c])
+    n_max = max(1, min(longest, n_channels))
+    block = min(n_max, n_vectors + 4)
+    # The fixed start block of subspace iteration (reproducible answers).
+    start = np.random.default_rng(0).standard_normal((n_max, block))
+    failed = _run(clips, &frames[0], n_channels, n_vectors, &values[0, 0], &vectors[0, 0, 0],
+                  longest, n_max, block, start, tolerance, check, max_steps)
     if failed >= 0:
         raise np.linalg.LinAlgError(f"clip {failed}: the eigen-decomposition did not converge.")
     return values_out, vectors_out
 
 
-cdef Py_ssize_t _run(Py_ssize_t m, const double** pointers, int* frames, int n_channels,
-                     int n_vectors, double* values, double* vectors, int longest, int n_max,
-                     int lwork, int liwork, double tolerance, int check, int max_steps):
+cdef Py_ssize_t _run(list clips, int* frames, int n_channels, int n_vectors, double* values,
+                     double* vectors, int longest, int n_max, int block,
+                     const double[:, ::1] start, double tolerance, int check,
+                     int max_steps) except? -2:
     """The loop over clips, without the GIL; the first failed clip, or -1."""
-    cdef double* scaled = <double*>malloc(max(1, longest * n_channels) * sizeof(double))
-    cdef double* gram = <double*>malloc(max(n_max * n_max, n_channels) * sizeof(double))
-    cdef double* scratch = <double*>malloc((n_max * (n_vectors + 2) + 2) * sizeof(double))
-    cdef double* work = <double*>malloc(lwork * sizeof(double))
-    cdef int* iwork = <int*>malloc(liwork * sizeof(int))
-    cdef int* support = <int*>malloc(2 * n_max * sizeof(int))
-    cdef Py_ssize_t c, failed = -1
-    if not (scaled and gram and scratch and work and iwork and support):
-        free(scaled); free(gram); free(scratch); free(work); free(iwork); free(support)
+    cdef Py_ssize_t m = len(clips), c, failed = -1
+    cdef const double** pointers = <const double**>malloc(max(m, 1) * sizeof(double*))
+    cdef const double[:, ::1] view
+    cdef Space s
+    cdef int n_work = max(n_max * n_max, n_channels) + 3 * n_max * block + 2 * block * block
+    n_work += n_max * (max(n_vectors, block) + 2) + 3 * block + 2
+    s.lqwork, s.lwork, s.liwork = 64 * n_max, max(26 * n_max, block * block), 10 * n_max
+    s.scaled = <double*>malloc(max(1, longest * n_channels) * sizeof(double))
+    s.gram = <double*>malloc((n_work + s.lqwork + s.lwork) * sizeof(double))
+    s.iwork = <int*>malloc((s.liwork + 2 * n_max) * sizeof(int))
+    if not (pointers and s.scaled and s.gram and s.iwork):
+        free(pointers); free(s.scaled); free(s.gram); free(s.iwork)
         raise MemoryError()
+    # One allocation carved into the double buffers, one into the int ones.
+    s.pairs = s.gram + max(n_max * n_max, n_channels)
+    s.x = s.pairs + n_max * (max(n_vectors, block) + 2)
+    s.y = s.x + n_max * block
+    s.p = s.y + n_max * block
+    s.h = s.p + n_max * block
+    s.r = s.h + block * block
+    s.ritz = s.r + block * block
+    s.tau = s.ritz + block
+    s.qwork = s.tau + block
+    s.work = s.qwork + s.lqwork
+    s.support = s.iwork + s.liwork
+    s.start, s.start_cols = &start[0, 0], block
+    for c in range(m):
+        view = clips[c]
+        pointers[c] = &view[0, 0] if view.shape[0] else NULL
     with nogil:
         for c in range(m):
             if pointers[c] == NULL:
                 continue
-            if _one_clip(pointers[c], frames[c], n_channels, n_vectors,
-                         values + c * n_vectors, vectors + c * n_channels * n_vectors,
-                         scaled, gram, scratch, work, lwork, iwork, liwork, support,
-                         tolerance, check, max_steps) != 0:
+            if _one_clip(pointers[c], frames[c], n_channels, n_vectors, values + c * n_vectors,
+                         vectors + c * n_channels * n_vectors, &s, tolerance, check,
+                         max_steps) != 0:
                 failed = c
                 break
-    free(scaled); free(gram); free(scratch); free(work); free(iwork); free(support)
+    free(pointers); free(s.scaled); free(s.gram); free(s.iwork)
     return failed

@@ -76,3 +76,26 @@ def test_iterative_first_vector_equals_the_exact_route():
     np.testing.assert_allclose(values[:, 0], exact_values[:, 0], rtol=1e-10)
     np.testing.assert_array_equal(values[:, 1:], 0.0)
     np.testing.assert_allclose(np.abs(vectors), np.abs(exact_vectors), atol=1e-7)
+
+
+@settings(max_examples=20, deadline=None)
+@given(
+    st.integers(0, 10_000),
+    st.sampled_from([(40, 60), (90, 30), (70, 24), (30, 45)]),
+    st.integers(2, 6),
+    st.integers(0, 8),
+)
+def test_subspace_iteration_matches_the_svd(seed, shape, n_vectors, n_constant):
+    # Matrices large enough for subspace iteration (block n_vectors + 4 under
+    # half the Gram size), motion-like decaying spectra, and clips whose
+    # constant channels leave the Gram matrix rank-deficient.
+    rng = np.random.default_rng(seed)
+    n_frames, n_channels = shape
+    decay = np.exp(-np.arange(n_channels) / rng.uniform(2, 8))
+    clips = [rng.normal(size=shape) * decay + rng.normal(size=n_channels) for _ in range(4)]
+    clips[0][:, :n_constant] = 0.0
+    values, vectors = leading_spectra(clips, n_vectors, 1e-9, 4, 24)
+    lapack = leading_spectra(clips, n_vectors, 1e-9, 4, 0)  # dsyevr for every clip
+    np.testing.assert_allclose(values, lapack[0], rtol=1e-9, atol=1e-12)
+    for clip, vals, vecs in zip(clips, values, vectors):
+        _check_against_svd(clip, vals, vecs, n_vectors)
