@@ -36,4 +36,10 @@ leading = Extension(
     ["skmotion/decomposition/_leading.pyx"],
     extra_compile_args=["-O3"],
 )
-setup(ext_modules=cythonize([beam, online, leading]))
+# psi distances of a leaf's queries to its candidates (neighbors/_interval_neighbors.py).
+psi_rank = Extension(
+    "skmotion.neighbors._psi_rank",
+    ["skmotion/neighbors/_psi_rank.pyx"],
+    extra_compile_args=["-O3"],
+)
+setup(ext_modules=cythonize([beam, online, leading, psi_rank]))

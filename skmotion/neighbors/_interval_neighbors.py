@@ -17,7 +17,8 @@ from skmotion.decomposition._svd_projection import (
 )
 from skmotion.neighbors._describe import clip_level_limit, index_spectra, resolve_levels
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
-from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
+from skmotion.neighbors._psi import signatures_from_spectra
+from skmotion.neighbors._psi_rank import psi_distances
 from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_k
 from skmotion.neighbors._store import GrowableStore
 from skmotion.neighbors._widths import learn_delta, radius_for_recall
@@ -34,6 +35,10 @@ _LEAVES_PER_TASK = 32
 _DEFAULT_LEVELS = 7
 # The recall the entry widths are learned for when neither rule is given.
 _DEFAULT_RECALL = 0.99
+
+
+def _ids(ids):
+    return np.ascontiguousarray(ids, dtype=np.intp)
 
 
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -509,11 +514,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     def _distances(self, ranking, rows, columns):
         if self.effective_metric_ == "euclidean":
             return euclidean_distances(ranking[rows], self._ranking[columns])
-        weights, vectors = ranking
-        stored_weights, stored_vectors = self._ranking
-        return 1.0 - psi_from_signatures(
-            weights[rows], vectors[rows], stored_weights[columns], stored_vectors[columns]
-        )
+        # Compiled: reads each candidate's signature in place (no gathered copy).
+        return psi_distances(*ranking, *self._ranking, _ids(rows), _ids(columns))
 
     def _rank_leaf(self, leaf, rows, ranking, self_ids, n_neighbors):
         columns = self.index_.leaf_items(leaf).astype(np.intp)

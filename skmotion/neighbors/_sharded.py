@@ -20,7 +20,8 @@ from skmotion.decomposition._svd_projection import N_VECTORS, fit_svd_projection
 from skmotion.neighbors._describe import clip_level_limit, index_spectra
 from skmotion.neighbors._interval_index import IntervalIndex
 from skmotion.neighbors._interval_neighbors import IntervalIndexNeighbors
-from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
+from skmotion.neighbors._psi import signatures_from_spectra
+from skmotion.neighbors._psi_rank import psi_distances
 from skmotion.neighbors._ranking import nearest_in_leaves, smallest_k
 from skmotion.utils._clips import check_clips
 
@@ -48,11 +49,8 @@ class _Shard:
         self.offset = offset
 
     def _distances(self, query, rows, columns):
-        weights, vectors = query
-        similarity = psi_from_signatures(
-            weights[rows], vectors[rows], self.weights[columns], self.vectors[columns]
-        )
-        return 1.0 - similarity
+        rows, columns = (np.ascontiguousarray(i, dtype=np.intp) for i in (rows, columns))
+        return psi_distances(*query, self.weights, self.vectors, rows, columns)
 
     def candidates(self, tree):
         return [c + self.offset for c in self.index.candidates(tree)]
