@@ -18,8 +18,12 @@ from skmotion.decomposition._svd_projection import (
 from skmotion.neighbors._describe import clip_level_limit, index_spectra, resolve_levels
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._psi import signatures_from_spectra
-from skmotion.neighbors._psi_rank import psi_distances
-from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_k
+from skmotion.neighbors._ranking import (
+    input_kind,
+    nearest_in_leaves,
+    psi_distance_block,
+    smallest_k,
+)
 from skmotion.neighbors._store import GrowableStore
 from skmotion.neighbors._widths import learn_delta, radius_for_recall
 from skmotion.utils._clips import check_clips
@@ -35,10 +39,6 @@ _LEAVES_PER_TASK = 32
 _DEFAULT_LEVELS = 7
 # The recall the entry widths are learned for when neither rule is given.
 _DEFAULT_RECALL = 0.99
-
-
-def _ids(ids):
-    return np.ascontiguousarray(ids, dtype=np.intp)
 
 
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -514,8 +514,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     def _distances(self, ranking, rows, columns):
         if self.effective_metric_ == "euclidean":
             return euclidean_distances(ranking[rows], self._ranking[columns])
-        # Compiled: reads each candidate's signature in place (no gathered copy).
-        return psi_distances(*ranking, *self._ranking, _ids(rows), _ids(columns))
+        return psi_distance_block(ranking, self._ranking, rows, columns)
 
     def _rank_leaf(self, leaf, rows, ranking, self_ids, n_neighbors):
         columns = self.index_.leaf_items(leaf).astype(np.intp)

@@ -21,8 +21,7 @@ from skmotion.neighbors._describe import clip_level_limit, index_spectra
 from skmotion.neighbors._interval_index import IntervalIndex
 from skmotion.neighbors._interval_neighbors import IntervalIndexNeighbors
 from skmotion.neighbors._psi import signatures_from_spectra
-from skmotion.neighbors._psi_rank import psi_distances
-from skmotion.neighbors._ranking import nearest_in_leaves, smallest_k
+from skmotion.neighbors._ranking import nearest_in_leaves, psi_distance_block, smallest_k
 from skmotion.utils._clips import check_clips
 
 __all__ = ["ShardedIntervalIndex"]
@@ -49,8 +48,7 @@ class _Shard:
         self.offset = offset
 
     def _distances(self, query, rows, columns):
-        rows, columns = (np.ascontiguousarray(i, dtype=np.intp) for i in (rows, columns))
-        return psi_distances(*query, self.weights, self.vectors, rows, columns)
+        return psi_distance_block(query, (self.weights, self.vectors), rows, columns)
 
     def candidates(self, tree):
         return [c + self.offset for c in self.index.candidates(tree)]

@@ -35,3 +35,21 @@ def test_signatures_must_match():
     a = (np.ones((2, 3)) / 3, np.ones((2, 3, 4)))
     with pytest.raises(ValueError, match="differ in k or in channels"):
         psi_distances(*a, np.ones((2, 2)), np.ones((2, 2, 4)), np.arange(2), np.arange(2))
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(0, 10_000), st.integers(1, 25))
+def test_both_ranking_routes_agree(seed, n_rows):
+    # psi_distance_block switches from the compiled loop to matrix products
+    # at _ROWS_FOR_PRODUCTS queries; either side gives the same distances.
+    from skmotion.neighbors._ranking import psi_distance_block
+
+    rng = np.random.default_rng(seed)
+    clips = check_clips([rng.normal(size=(12, 7)) for _ in range(40)])
+    signatures = psi_signatures(clips, 6)
+    rows = np.sort(rng.choice(40, size=n_rows, replace=False))
+    columns = np.sort(rng.choice(40, size=30, replace=False))
+    block = psi_distance_block(signatures, signatures, rows, columns)
+    np.testing.assert_allclose(
+        block, psi_distances(*signatures, *signatures, rows, columns), rtol=0, atol=1e-14
+    )
