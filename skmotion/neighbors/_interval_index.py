@@ -294,13 +294,8 @@ class IntervalIndex:
         """For each query, the sorted ids of the items in the leaf it reaches."""
         return self.items_of_leaves(self.leaf_of(vectors))
 
-    def items_of_leaves(self, leaves):
-        """:meth:`leaf_items` of many leaves (as ``intp`` arrays), one look-up per block.
-
-        Each block is searched once for all the leaves (one ``searchsorted``);
-        what is left per leaf is a slice (or, after insertions, a concatenation
-        of one slice per block, oldest block first: ids increase).
-        """
+    def _leaf_bounds(self, leaves):
+        """The non-empty blocks, and per block where each leaf's items start and end."""
         leaves = np.asarray(leaves)
         blocks = [block for block in self._blocks if len(block[0])]
         bounds = []
@@ -309,7 +304,25 @@ class IntervalIndex:
             inside = np.minimum(at, len(block_leaves) - 1)
             hit = (at < len(block_leaves)) & (block_leaves[inside] == leaves)
             start = np.where(hit, offsets[inside], 0)
-            bounds.append((start.tolist(), np.where(hit, offsets[inside + hit], 0).tolist()))
+            bounds.append((start, np.where(hit, offsets[inside + hit], 0)))
+        return blocks, bounds
+
+    def leaf_sizes(self, leaves):
+        """How many items each leaf holds (``len(leaf_items(leaf))``, for many leaves at once)."""
+        sizes = np.zeros(len(leaves), dtype=np.intp)
+        for start, end in self._leaf_bounds(leaves)[1]:
+            sizes += end - start
+        return sizes
+
+    def items_of_leaves(self, leaves):
+        """:meth:`leaf_items` of many leaves (as ``intp`` arrays), one look-up per block.
+
+        Each block is searched once for all the leaves (one ``searchsorted``);
+        what is left per leaf is a slice (or, after insertions, a concatenation
+        of one slice per block, oldest block first: ids increase).
+        """
+        blocks, bounds = self._leaf_bounds(leaves)
+        bounds = [(start.tolist(), end.tolist()) for start, end in bounds]
         if len(blocks) == 1:
             items = blocks[0][2]
             return [items[a:b].astype(np.intp) for a, b in zip(*bounds[0])]

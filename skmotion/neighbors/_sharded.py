@@ -64,7 +64,7 @@ class _Shard:
         tree, query = payload
         n = len(self.weights)
         leaves = self.index.leaf_of(tree)
-        counts = np.array([len(self.index.leaf_items(leaf)) for leaf in leaves])
+        counts = self.index.leaf_sizes(leaves)
         if everything is None:
             everything = np.zeros(len(tree), dtype=bool)
 
@@ -202,7 +202,9 @@ class ShardedIntervalIndex:
                 f"n_neighbors must be an integer from 1 to {self.n_samples_fit_}; "
                 f"got {n_neighbors!r}."
             )
-        payload = self.client.scatter([self._query(X)], broadcast=True)[0]
+        # The queries' features go with the tasks (a few hundred kB for hundreds
+        # of queries): a scatter first would cost the scheduler another round trip.
+        payload = self._query(X)
         parts = self._each("nearest", payload, n_neighbors)
         everything = sum(p[0] for p in parts) < n_neighbors
         if everything.any():  # a second round only for queries whose leaves hold too few

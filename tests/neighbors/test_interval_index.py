@@ -175,3 +175,6 @@ def test_items_of_many_leaves_equal_each_leafs_items(seed, n_insertions):
     for leaf, items in zip(leaves, index.items_of_leaves(leaves)):
         assert items.dtype == np.intp
         np.testing.assert_array_equal(items, index.leaf_items(leaf))
+    np.testing.assert_array_equal(
+        index.leaf_sizes(leaves), [len(index.leaf_items(leaf)) for leaf in leaves]
+    )
