@@ -153,10 +153,16 @@ class ShardedIntervalIndex:
         clips = check_clips(X, estimator=layout, reset=True)
         y = layout._check_labels(y, len(clips))
         weighting = layout._weighting()
-        n_shards = self.n_shards or len(self.client.scheduler_info()["workers"])
+        workers = sorted(self.client.scheduler_info()["workers"])
+        n_shards = self.n_shards or len(workers)
         bounds = np.linspace(0, len(clips), n_shards + 1).astype(int)
         parts = [list(clips[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
-        spectra = [self.client.submit(_spectra, p, weighting, layout.k) for p in parts]
+        # Shard i lives on worker i (modulo their number), and is built where its
+        # spectra are: the shards of one query batch then rank in parallel.
+        where = [{"workers": [workers[i % len(workers)]]} for i in range(n_shards)]
+        spectra = [
+            self.client.submit(_spectra, p, weighting, layout.k, **w) for p, w in zip(parts, where)
+        ]
         summaries = self.client.gather(
             [self.client.submit(_summary, s, N_VECTORS[weighting]) for s in spectra]
         )
@@ -169,8 +175,8 @@ class ShardedIntervalIndex:
         layout.classes_ = np.unique(y)
         edges, radius = layout._layout(tree, np.searchsorted(layout.classes_, y), None)
         self.shards_ = [
-            self.client.submit(_Shard, s, tree[a:b], edges, radius, layout.k, a)
-            for s, a, b in zip(spectra, bounds[:-1], bounds[1:])
+            self.client.submit(_Shard, s, tree[a:b], edges, radius, layout.k, a, **w)
+            for s, a, b, w in zip(spectra, bounds[:-1], bounds[1:], where)
         ]
         _wait(self.shards_)  # until built (the shards stay on the workers)
         self.layout_, self.labels_, self.n_samples_fit_ = layout, np.asarray(y), len(clips)
