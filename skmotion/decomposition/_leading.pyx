@@ -4,8 +4,9 @@
 One call takes a list of clips of any lengths and, clip after clip with no
 Python between (and without the GIL):
 
-1. divides the clip by its largest absolute value (into a scratch buffer: the
-   Gram matrix of a clip near 1e300 would overflow);
+1. divides the clip by its largest absolute value (the Gram matrix of a clip
+   near 1e300 would overflow): for a peak between 1e-100 and 1e100 by scaling
+   the Gram matrix, otherwise by copying the scaled clip first;
 2. forms the smaller Gram matrix, ``A^T A`` (channels x channels) or ``A A^T``
    (frames x frames) for a clip with fewer frames than channels, with one
    ``dsyrk``;
@@ -345,7 +346,8 @@ cdef int _one_clip(const double* clip, int n_frames, int n_channels, int n_vecto
     """
     cdef int size = n_frames * n_channels, i, j, n, n_pairs, info = 0
     cdef bint tall = n_frames >= n_channels
-    cdef double peak = 0.0, alpha = 1.0, beta = 0.0, norm
+    cdef double peak = 0.0, alpha = 1.0, beta = 0.0, norm, squared
+    cdef const double* a = clip
     cdef char uplo = b"L", no = b"N", yes = b"T"
     cdef int one = 1
     for i in range(size):
@@ -353,15 +355,23 @@ cdef int _one_clip(const double* clip, int n_frames, int n_channels, int n_vecto
             peak = fabs(clip[i])
     if peak == 0.0:
         return 0  # an all-zero clip: zero values and vectors
-    for i in range(size):
-        s.scaled[i] = clip[i] / peak
+    if 1e-100 < peak < 1e100:
+        # The Gram matrix of the clip itself cannot overflow or underflow: scale
+        # it (by 1 / peak^2) instead of copying the clip.
+        squared = (1.0 / peak) * (1.0 / peak)
+    else:
+        squared = 1.0
+        for i in range(size):
+            s.scaled[i] = clip[i] / peak
+        a = s.scaled
     # The row-major clip (frames x channels) is the column-major B = A^T
     # (channels x frames): A^T A = B B^T, A A^T = B^T B.
     n = n_channels if tall else n_frames
     if tall:
-        _dsyrk(&uplo, &no, &n, &n_frames, &alpha, s.scaled, &n_channels, &beta, s.gram, &n)
+        _dsyrk(&uplo, &no, &n, &n_frames, &squared, <double*>a, &n_channels, &beta, s.gram, &n)
     else:
-        _dsyrk(&uplo, &yes, &n, &n_channels, &alpha, s.scaled, &n_channels, &beta, s.gram, &n)
+        _dsyrk(&uplo, &yes, &n, &n_channels, &squared, <double*>a, &n_channels, &beta, s.gram,
+               &n)
     n_pairs = n_vectors if n_vectors < n else n
     info = _pairs_of_gram(n, n_pairs, s, values, tolerance, check, max_steps)
     for j in range(n_pairs):
@@ -369,7 +379,7 @@ cdef int _one_clip(const double* clip, int n_frames, int n_channels, int n_vecto
             for i in range(n_channels):
                 vectors[i * n_vectors + j] = s.pairs[j * n + i]
         else:  # v = A^T w = B w (into gram, no longer needed), then unit norm
-            _dgemv(&no, &n_channels, &n_frames, &alpha, s.scaled, &n_channels,
+            _dgemv(&no, &n_channels, &n_frames, &alpha, <double*>a, &n_channels,
                    s.pairs + j * n, &one, &beta, s.gram, &one)
             norm = 0.0
             for i in range(n_channels):
