@@ -35,4 +35,17 @@ position_frame = Extension(
     ["skmotion/preprocessing/_position_frame_loops.pyx"],
     extra_compile_args=["-O3"],
 )
-setup(ext_modules=cythonize([beam, online, position_frame]))
+# Leading eigenpairs of each clip's Gram matrix (decomposition/_clip_svd.py): SciPy's
+# BLAS/LAPACK through the pointers SciPy exports, so no build-time SciPy.
+leading = Extension(
+    "skmotion.decomposition._leading",
+    ["skmotion/decomposition/_leading.pyx"],
+    extra_compile_args=["-O3"],
+)
+# psi distances of a leaf's queries to its candidates (neighbors/_interval_neighbors.py).
+psi_rank = Extension(
+    "skmotion.neighbors._psi_rank",
+    ["skmotion/neighbors/_psi_rank.pyx"],
+    extra_compile_args=["-O3"],
+)
+setup(ext_modules=cythonize([beam, online, position_frame, leading, psi_rank]))

@@ -14,6 +14,7 @@ import numpy as np
 # threadpoolctl comes with scikit-learn (one of its own dependencies).
 from threadpoolctl import ThreadpoolController
 
+from skmotion.decomposition._leading import leading_spectra
 from skmotion.utils._parallel import parallel_map
 
 __all__ = ["clip_spectra", "small_blas"]
@@ -61,89 +62,9 @@ def _unit_scale(clip):
     return clip / peak if peak > 0 else clip
 
 
-def _leading_eigh(grams, n_vectors):
-    """Leading eigenpairs of stacked symmetric matrices by subspace iteration.
-
-    A block of ``n_vectors + 4`` vectors is multiplied by the matrices and
-    re-orthonormalised (one batched QR) a few times, then a Rayleigh-Ritz step
-    (a batched eigh of ``block x block`` matrices) gives the pairs. Every
-    ``_CHECK`` steps the residuals ``|G v - lambda v|`` are checked against
-    ``_TOLERANCE * lambda_1``; matrices not converged after ``_MAX_STEPS``
-    (close eigenvalues, slow convergence) get a full ``eigh``, so the answer is
-    always within the tolerance. Returns values (decreasing) and vectors.
-    """
-    m, d, _ = grams.shape
-    block = min(d, n_vectors + 4)
-    if 2 * block >= d:  # small matrices: the full decomposition costs no more
-        values, vectors = np.linalg.eigh(grams)
-        return values[:, ::-1][:, :n_vectors], vectors[:, :, ::-1][:, :, :n_vectors]
-    if n_vectors == 1:
-        start = grams.sum(axis=2, keepdims=True) + grams[:, :, :1]
-        start /= np.maximum(np.linalg.norm(start, axis=1, keepdims=True), np.finfo(float).tiny)
-        values, vectors, todo = _leading_pair(lambda rows, x: grams[rows] @ x, start)
-        if len(todo):
-            exact_values, exact_vectors = np.linalg.eigh(grams[todo])
-            values[todo], vectors[todo] = exact_values[:, -1:], exact_vectors[:, :, -1:]
-        return values, vectors
-    start = np.random.default_rng(0).standard_normal((d, block))  # fixed: reproducible
-    basis = np.linalg.qr(grams @ start)[0]
-    values = np.zeros((m, n_vectors))
-    vectors = np.zeros((m, d, n_vectors))
-    todo = np.arange(m)
-    for step in range(2, _MAX_STEPS + 1, 2):
-        # Two products per orthonormalisation: the QR costs more than a product,
-        # and the Gram matrices of unit-scaled clips keep G^2 X well within range.
-        active = grams[todo]
-        basis = np.linalg.qr(active @ (active @ basis))[0]
-        if step % _CHECK and step < _MAX_STEPS:
-            continue
-        product = active @ basis
-        ritz, rotation = np.linalg.eigh(np.swapaxes(basis, 1, 2) @ product)
-        rotation = rotation[:, :, ::-1][:, :, :n_vectors]
-        ritz = ritz[:, ::-1][:, :n_vectors]
-        candidate = basis @ rotation
-        residual = np.linalg.norm(product @ rotation - candidate * ritz[:, None, :], axis=1)
-        done = (residual <= _TOLERANCE * np.abs(ritz[:, :1])).all(axis=1)
-        values[todo[done]], vectors[todo[done]] = ritz[done], candidate[done]
-        todo, basis = todo[~done], basis[~done]
-        if not len(todo):
-            return values, vectors
-    exact_values, exact_vectors = np.linalg.eigh(grams[todo])
-    values[todo] = exact_values[:, ::-1][:, :n_vectors]
-    vectors[todo] = exact_vectors[:, :, ::-1][:, :, :n_vectors]
-    return values, vectors
-
-
-def _leading_pair(apply, start):
-    """The leading eigenpair of stacked symmetric PSD matrices ``G`` by power iteration.
-
-    ``apply(rows, x)`` is ``G[rows] @ x``. (Steps ``A^T (A x)`` on the clips,
-    without forming ``G``, were measured slower: numpy's stacked matrix-vector
-    products do not reach BLAS speed.) Uncentred motion clips have a
-    dominant first singular value (the mean posture), so plain power steps (a
-    product and a normalisation, no QR) converge in a few steps; the residual
-    is checked as in :func:`_leading_eigh`, and ``None`` marks the rows that did
-    not converge. Returns ``(values (m, 1), vectors (m, d, 1), unconverged rows)``.
-    """
-    m, d, _ = start.shape
-    values, vectors = np.zeros((m, 1)), np.zeros((m, d, 1))
-    todo, vector = np.arange(m), start
-    for step in range(1, 4 * _MAX_STEPS + 1):
-        product = apply(todo, vector)
-        if step % _CHECK == 0:
-            value = (vector * product).sum(axis=1)  # the Rayleigh quotient of unit vectors
-            residual = np.linalg.norm(product - vector * value[:, None, :], axis=1)
-            done = (residual[:, 0] <= _TOLERANCE * np.abs(value[:, 0])) & (step > 1)
-            values[todo[done]], vectors[todo[done]] = value[done], vector[done]
-            todo, product = todo[~done], product[~done]
-            if not len(todo):
-                break
-        norms = np.linalg.norm(product, axis=1, keepdims=True)
-        vector = product / np.maximum(norms, np.finfo(float).tiny)
-    return values, vectors, todo
-
-
 def _spectra_of_chunk(chunk, n_vectors, method):
+    if method == "iterative":
+        return _leading_pairs(chunk, n_vectors)
     n = chunk[0].shape[1]
     eigenvalues = np.zeros((len(chunk), n))
     vectors = np.zeros((len(chunk), n, n_vectors))
@@ -159,11 +80,8 @@ def _spectra_of_chunk(chunk, n_vectors, method):
         clips = clips / np.where(peak > 0, peak, 1.0)  # see _unit_scale
         tall = length >= n
         grams = np.swapaxes(clips, 1, 2) @ clips if tall else clips @ np.swapaxes(clips, 1, 2)
-        if method == "iterative":
-            values, vecs = _leading_eigh(grams, min(n_vectors, grams.shape[1]))
-        else:
-            values, vecs = np.linalg.eigh(grams)
-            values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
+        values, vecs = np.linalg.eigh(grams)
+        values, vecs = values[:, ::-1], vecs[:, :, ::-1][:, :, :n_vectors]  # decreasing
         if not tall:
             # Right singular vectors from the left ones: v = A^T w / |A^T w|.
             vecs = np.swapaxes(clips, 1, 2) @ vecs
@@ -171,6 +89,30 @@ def _spectra_of_chunk(chunk, n_vectors, method):
             vecs = np.divide(vecs, norms, out=np.zeros_like(vecs), where=norms > 0)
         eigenvalues[rows, : values.shape[1]] = values
         vectors[rows, :, : vecs.shape[2]] = vecs
+    return _zero_beyond_rank(eigenvalues, vectors)
+
+
+def _leading_pairs(chunk, n_vectors):
+    """The leading pairs of each clip by the compiled kernel (any lengths, one call).
+
+    Power steps (one pair) or subspace iteration (a block of ``n_vectors + 4``,
+    two products per QR, a Rayleigh-Ritz step every ``_CHECK`` steps) on the
+    smaller Gram matrix, each pair's residual ``|G v - lambda v|`` within
+    ``_TOLERANCE * lambda_1``, and LAPACK's ``dsyevr`` for the clips not
+    converged after ``_MAX_STEPS`` (or whose matrix is small enough that the
+    full problem costs no more). Compiled, because numpy's per-call cost on
+    small stacked matrices was most of a query's cost.
+    """
+    n = chunk[0].shape[1]
+    clips = [np.ascontiguousarray(c, dtype=np.float64) for c in chunk]
+    values, vectors = leading_spectra(clips, n_vectors, _TOLERANCE, _CHECK, _MAX_STEPS)
+    eigenvalues = np.zeros((len(chunk), n))
+    eigenvalues[:, :n_vectors] = values
+    return _zero_beyond_rank(eigenvalues, vectors)
+
+
+def _zero_beyond_rank(eigenvalues, vectors):
+    n, n_vectors = vectors.shape[1:]
     eigenvalues = np.clip(eigenvalues, 0.0, None)
     # Directions beyond a clip's rank are undefined: make them zero vectors, so
     # that every caller treats them the same whichever route computed them.
@@ -191,9 +133,11 @@ def clip_spectra(clips, n_vectors, *, method="exact", n_jobs=None):
         How many leading right singular vectors to return (at most ``n_channels``).
     method : {"exact", "iterative"}, default="exact"
         ``"exact"``: a full batched ``eigh`` of each Gram matrix, all eigenvalues.
-        ``"iterative"``: subspace iteration for the ``n_vectors`` leading pairs
-        only, each within ``1e-9 * lambda_1`` in residual (a full ``eigh``
-        otherwise); the eigenvalues beyond ``n_vectors`` are then returned as 0.
+        ``"iterative"``: the ``n_vectors`` leading pairs only, by a compiled
+        loop over the clips (power steps for one pair, subspace iteration for
+        several), each within ``1e-9 * lambda_1`` in residual (LAPACK's
+        ``dsyevr`` otherwise); the eigenvalues beyond ``n_vectors`` are then
+        returned as 0.
     n_jobs : int, default=None
         Number of jobs over chunks of clips; results do not depend on it.
 

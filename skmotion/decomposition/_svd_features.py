@@ -140,12 +140,18 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
             The fitted transformer.
         """
         clips = check_clips(X, estimator=self, reset=True)
-        spectra = clip_spectra(clips, N_VECTORS[self.weighting], n_jobs=self.n_jobs)
+        spectra = self._spectra(clips)
         n_components = resolve_n_components(
             self.n_components, len(clips), clips.n_channels, self.weighting
         )
         self._set_projection(fit_svd_projection(*spectra, n_components, self.weighting))
         return self
+
+    def _spectra(self, clips):
+        # "first" needs the leading pair only (the compiled iterative route, the
+        # interval index's); "first_two" weighs by all the singular values.
+        method = "iterative" if self.weighting == "first" else "exact"
+        return clip_spectra(clips, N_VECTORS[self.weighting], method=method, n_jobs=self.n_jobs)
 
     @classmethod
     def from_projection(cls, projection, n_features_in, *, n_jobs=None):
@@ -201,7 +207,7 @@ class SVDFeatureExtractor(ClipFeatureMixin, BaseEstimator):
         """
         check_is_fitted(self)
         clips = check_clips(X, estimator=self)
-        spectra = clip_spectra(clips, N_VECTORS[self.weighting], n_jobs=self.n_jobs)
+        spectra = self._spectra(clips)
         return self._wrap_table(svd_project(self.projection_, *spectra), clips)
 
     def get_feature_names_out(self, input_features=None):

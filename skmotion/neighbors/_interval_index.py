@@ -292,7 +292,46 @@ class IntervalIndex:
 
     def candidates(self, vectors):
         """For each query, the sorted ids of the items in the leaf it reaches."""
-        return [self.leaf_items(leaf).astype(np.intp) for leaf in self.leaf_of(vectors)]
+        return self.items_of_leaves(self.leaf_of(vectors))
+
+    def _leaf_bounds(self, leaves):
+        """The non-empty blocks, and per block where each leaf's items start and end."""
+        leaves = np.asarray(leaves)
+        blocks = [block for block in self._blocks if len(block[0])]
+        bounds = []
+        for block_leaves, offsets, _ in blocks:
+            at = np.searchsorted(block_leaves, leaves)
+            inside = np.minimum(at, len(block_leaves) - 1)
+            hit = (at < len(block_leaves)) & (block_leaves[inside] == leaves)
+            start = np.where(hit, offsets[inside], 0)
+            bounds.append((start, np.where(hit, offsets[inside + hit], 0)))
+        return blocks, bounds
+
+    def leaf_sizes(self, leaves):
+        """How many items each leaf holds (``len(leaf_items(leaf))``, for many leaves at once)."""
+        sizes = np.zeros(len(leaves), dtype=np.intp)
+        for start, end in self._leaf_bounds(leaves)[1]:
+            sizes += end - start
+        return sizes
+
+    def items_of_leaves(self, leaves):
+        """:meth:`leaf_items` of many leaves (as ``intp`` arrays), one look-up per block.
+
+        Each block is searched once for all the leaves (one ``searchsorted``);
+        what is left per leaf is a slice (or, after insertions, a concatenation
+        of one slice per block, oldest block first: ids increase).
+        """
+        blocks, bounds = self._leaf_bounds(leaves)
+        bounds = [(start.tolist(), end.tolist()) for start, end in bounds]
+        if len(blocks) == 1:
+            items = blocks[0][2]
+            return [items[a:b].astype(np.intp) for a, b in zip(*bounds[0])]
+        return [
+            np.concatenate(
+                [_EMPTY] + [block[2][b[0][q] : b[1][q]] for block, b in zip(blocks, bounds)]
+            ).astype(np.intp)
+            for q in range(len(leaves))
+        ]
 
     def nbytes(self):
         """Memory held by the tree: node tables and leaf blocks."""

@@ -17,8 +17,13 @@ from skmotion.decomposition._svd_projection import (
 )
 from skmotion.neighbors._describe import clip_level_limit, index_spectra, resolve_levels
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
-from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
-from skmotion.neighbors._ranking import input_kind, nearest_in_leaves, smallest_k
+from skmotion.neighbors._psi import signatures_from_spectra
+from skmotion.neighbors._ranking import (
+    input_kind,
+    nearest_in_leaves,
+    psi_distance_block,
+    smallest_k,
+)
 from skmotion.neighbors._store import GrowableStore
 from skmotion.neighbors._widths import learn_delta, radius_for_recall
 from skmotion.utils._clips import check_clips
@@ -509,11 +514,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     def _distances(self, ranking, rows, columns):
         if self.effective_metric_ == "euclidean":
             return euclidean_distances(ranking[rows], self._ranking[columns])
-        weights, vectors = ranking
-        stored_weights, stored_vectors = self._ranking
-        return 1.0 - psi_from_signatures(
-            weights[rows], vectors[rows], stored_weights[columns], stored_vectors[columns]
-        )
+        return psi_distance_block(ranking, self._ranking, rows, columns)
 
     def _rank_leaf(self, leaf, rows, ranking, self_ids, n_neighbors):
         columns = self.index_.leaf_items(leaf).astype(np.intp)

@@ -5,9 +5,32 @@ import pandas as pd
 import scipy.sparse as sp
 
 from skmotion.decomposition._clip_svd import small_blas
+from skmotion.neighbors._psi import psi_from_signatures
+from skmotion.neighbors._psi_rank import psi_distances
 from skmotion.utils._parallel import parallel_map
 
-__all__ = ["input_kind", "nearest_in_leaves", "smallest_k"]
+__all__ = ["input_kind", "nearest_in_leaves", "psi_distance_block", "smallest_k"]
+
+# From this many queries in one leaf, gathering the candidates' signatures and
+# multiplying matrices beats the compiled pair-by-pair loop (measured at 300 and
+# 3,000 candidates, 30 and 60 channels: the cross-over is at 8-12 queries).
+_ROWS_FOR_PRODUCTS = 10
+
+
+def psi_distance_block(query, stored, rows, columns):
+    """``1 - psi`` between queries ``rows`` and stored clips ``columns`` (signatures).
+
+    A few queries: the compiled loop reading each candidate's signature in
+    place (no gathered copy); many: matrix products over gathered signatures.
+    The two agree to rounding (tested).
+    """
+    if len(rows) >= _ROWS_FOR_PRODUCTS:
+        (weights, vectors), (stored_weights, stored_vectors) = query, stored
+        return 1.0 - psi_from_signatures(
+            weights[rows], vectors[rows], stored_weights[columns], stored_vectors[columns]
+        )
+    rows, columns = (np.ascontiguousarray(i, dtype=np.intp) for i in (rows, columns))
+    return psi_distances(*query, *stored, rows, columns)
 
 
 def input_kind(X):

@@ -20,8 +20,8 @@ from skmotion.decomposition._svd_projection import N_VECTORS, fit_svd_projection
 from skmotion.neighbors._describe import clip_level_limit, index_spectra
 from skmotion.neighbors._interval_index import IntervalIndex
 from skmotion.neighbors._interval_neighbors import IntervalIndexNeighbors
-from skmotion.neighbors._psi import psi_from_signatures, signatures_from_spectra
-from skmotion.neighbors._ranking import nearest_in_leaves, smallest_k
+from skmotion.neighbors._psi import signatures_from_spectra
+from skmotion.neighbors._ranking import nearest_in_leaves, psi_distance_block, smallest_k
 from skmotion.utils._clips import check_clips
 
 __all__ = ["ShardedIntervalIndex"]
@@ -48,11 +48,7 @@ class _Shard:
         self.offset = offset
 
     def _distances(self, query, rows, columns):
-        weights, vectors = query
-        similarity = psi_from_signatures(
-            weights[rows], vectors[rows], self.weights[columns], self.vectors[columns]
-        )
-        return 1.0 - similarity
+        return psi_distance_block(query, (self.weights, self.vectors), rows, columns)
 
     def candidates(self, tree):
         return [c + self.offset for c in self.index.candidates(tree)]
@@ -68,7 +64,7 @@ class _Shard:
         tree, query = payload
         n = len(self.weights)
         leaves = self.index.leaf_of(tree)
-        counts = np.array([len(self.index.leaf_items(leaf)) for leaf in leaves])
+        counts = self.index.leaf_sizes(leaves)
         if everything is None:
             everything = np.zeros(len(tree), dtype=bool)
 
@@ -157,10 +153,16 @@ class ShardedIntervalIndex:
         clips = check_clips(X, estimator=layout, reset=True)
         y = layout._check_labels(y, len(clips))
         weighting = layout._weighting()
-        n_shards = self.n_shards or len(self.client.scheduler_info()["workers"])
+        workers = sorted(self.client.scheduler_info()["workers"])
+        n_shards = self.n_shards or len(workers)
         bounds = np.linspace(0, len(clips), n_shards + 1).astype(int)
         parts = [list(clips[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
-        spectra = [self.client.submit(_spectra, p, weighting, layout.k) for p in parts]
+        # Shard i lives on worker i (modulo their number), and is built where its
+        # spectra are: the shards of one query batch then rank in parallel.
+        where = [{"workers": [workers[i % len(workers)]]} for i in range(n_shards)]
+        spectra = [
+            self.client.submit(_spectra, p, weighting, layout.k, **w) for p, w in zip(parts, where)
+        ]
         summaries = self.client.gather(
             [self.client.submit(_summary, s, N_VECTORS[weighting]) for s in spectra]
         )
@@ -173,8 +175,8 @@ class ShardedIntervalIndex:
         layout.classes_ = np.unique(y)
         edges, radius = layout._layout(tree, np.searchsorted(layout.classes_, y), None)
         self.shards_ = [
-            self.client.submit(_Shard, s, tree[a:b], edges, radius, layout.k, a)
-            for s, a, b in zip(spectra, bounds[:-1], bounds[1:])
+            self.client.submit(_Shard, s, tree[a:b], edges, radius, layout.k, a, **w)
+            for s, a, b, w in zip(spectra, bounds[:-1], bounds[1:], where)
         ]
         _wait(self.shards_)  # until built (the shards stay on the workers)
         self.layout_, self.labels_, self.n_samples_fit_ = layout, np.asarray(y), len(clips)
@@ -206,7 +208,9 @@ class ShardedIntervalIndex:
                 f"n_neighbors must be an integer from 1 to {self.n_samples_fit_}; "
                 f"got {n_neighbors!r}."
             )
-        payload = self.client.scatter([self._query(X)], broadcast=True)[0]
+        # The queries' features go with the tasks (a few hundred kB for hundreds
+        # of queries): a scatter first would cost the scheduler another round trip.
+        payload = self._query(X)
         parts = self._each("nearest", payload, n_neighbors)
         everything = sum(p[0] for p in parts) < n_neighbors
         if everything.any():  # a second round only for queries whose leaves hold too few

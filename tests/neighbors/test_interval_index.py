@@ -159,3 +159,22 @@ def test_one_query_path_equals_the_batched_path(seed, n_levels, max_entries):
     np.testing.assert_array_equal(
         [index.leaf_of(q[None])[0] for q in queries], index._leaf_of_batch(queries)
     )
+
+
+@given(st.integers(0, 10_000), st.integers(1, 6))
+def test_items_of_many_leaves_equal_each_leafs_items(seed, n_insertions):
+    # Several insertions leave several leaf blocks (merged or not); the batched
+    # look-up equals leaf_items leaf by leaf, for empty and unknown leaves too.
+    rng = np.random.default_rng(seed)
+    edges = [np.linspace(-1, 1, 6)[1:-1]] * 2
+    index = IntervalIndex(edges, [0.2, 0.3])
+    assert [c.tolist() for c in index.items_of_leaves(np.array([0, 1]))] == [[], []]
+    for size in rng.integers(1, 30, size=n_insertions):
+        index.insert(rng.uniform(-1.2, 1.2, (size, 2)))
+    leaves = np.r_[np.arange(index._n_leaves + 2), rng.integers(0, index._n_leaves, 20)]
+    for leaf, items in zip(leaves, index.items_of_leaves(leaves)):
+        assert items.dtype == np.intp
+        np.testing.assert_array_equal(items, index.leaf_items(leaf))
+    np.testing.assert_array_equal(
+        index.leaf_sizes(leaves), [len(index.leaf_items(leaf)) for leaf in leaves]
+    )

@@ -75,3 +75,14 @@ def test_sharded_refuses_psi_pairs_and_bad_k(client, motions):
     sharded = ShardedIntervalIndex(client=client).fit(stored, labels)
     with pytest.raises(ValueError, match="n_neighbors must be an integer from 1 to"):
         sharded.kneighbors(queries, n_neighbors=len(stored) + 1)
+
+
+def test_shards_are_spread_over_the_workers(client, motions):
+    # One shard per worker, so that a query batch is ranked on both in parallel.
+    train, labels, _ = motions
+    sharded = ShardedIntervalIndex(
+        IntervalIndexNeighbors(random_state=0), client=client, n_shards=2
+    ).fit(train, labels)
+    holders = client.who_has(sharded.shards_)
+    workers = [tuple(holders[f.key]) for f in sharded.shards_]
+    assert sorted(w for ws in workers for w in ws) == sorted(client.scheduler_info()["workers"])
