@@ -210,7 +210,12 @@ def _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name)
     clips = []
     n_channels = None
     for i, clip in enumerate(raw):
-        arr, target = _as_float_clip(clip, i, dtypes, input_name)
+        # Fast path (queries arrive as many small clips): a float array already in
+        # an accepted dtype needs none of the conversions below.
+        if type(clip) is np.ndarray and clip.dtype in dtypes:
+            arr, target = clip, clip.dtype
+        else:
+            arr, target = _as_float_clip(clip, i, dtypes, input_name)
         if arr.ndim != 2:
             raise ValueError(
                 f"{input_name}: clip {i} is {arr.ndim}-D with shape {arr.shape}; "
