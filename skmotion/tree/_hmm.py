@@ -11,17 +11,15 @@ from sklearn.utils.validation import check_is_fitted, column_or_1d
 from skmotion.base import ClipFeatureMixin, MotionTags
 from skmotion.tree._batch import decode_clips
 from skmotion.tree._calibration import (
+    class_score_features,
+    class_score_names,
     fit_temperature,
+    held_out_folds,
+    layer_class_scores,
     log_softmax_rows,
     mixture_log_density,
     per_frame,
     sum_of_paths,
-)
-from skmotion.tree._class_scores import (
-    class_score_features,
-    class_score_names,
-    held_out_folds,
-    layer_class_scores,
 )
 from skmotion.tree._decode import NODE_PRIORS
 from skmotion.tree._gaussian import COVARIANCE_TYPES

@@ -15,7 +15,7 @@ from sklearn.pipeline import make_pipeline, make_union
 
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTreeEncoder, MotionTreeHMM, TransitionGraphs, node_log_posterior
-from skmotion.tree._class_scores import held_out_folds
+from skmotion.tree._calibration import held_out_folds
 
 
 def blobs(seed=3):
