@@ -115,11 +115,14 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
         input's units either way.
     calibration_cv : int or None, default=3
         Folds of the internal cross-validation that fits the temperature of
-        ``predict_proba`` (stratified, shuffled with a fixed seed; at most the
-        smallest class's clip count). The tree is built once on all frames
-        (it sees no labels); each fold recounts the graphs without its
-        held-out clips and scores them. None, or a smallest class of one
-        clip, keeps ``temperature_ = 1``. Labels (``predict``) never depend on it.
+        ``predict_proba`` and gives ``fit_transform``'s out-of-fold rows
+        (stratified, each class's clips cut in the order given into contiguous
+        blocks, so overlapping windows of one take stay mostly in one fold; at
+        most the smallest class's clip count; by group when ``fit`` gets
+        ``groups``). The tree is built once on all frames (it sees no labels);
+        each fold recounts the graphs without its held-out clips and scores
+        them. None, or a smallest class of one clip, keeps ``temperature_ = 1``.
+        Labels (``predict``) never depend on it.
     verbose : int, default=0
         0 is silent; 1 or more reports the stages of ``fit`` (tree, graphs,
         calibration folds) on standard error.
