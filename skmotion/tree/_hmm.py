@@ -49,7 +49,9 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
     and one graph per class (or per clip). A clip's *generation probability*
     under a graph sums the ``n_paths`` best node sequences found by the
     top-down beam Viterbi (:func:`beam_decode`); ``predict`` picks the class
-    whose graph generates the clip with the highest probability.
+    whose graph generates the clip with the highest probability, and
+    ``transform`` gives those probabilities per scored layer, per frame and
+    normalised over the classes, as features for a model stacked on it.
 
     Parameters
     ----------
