@@ -648,7 +648,7 @@ def stacking_study(quick):
         if name.startswith("CMU"):
             folds["CV (contiguous 5-fold)"] = list(StratifiedKFold(5).split(Xtr, ytr))
         for method, make in candidates.items():
-            row = {"dataset": name, "method": method}
+            row = {"dataset": name, "method": method, "CV (contiguous 5-fold)": ""}
             for label, splits in folds.items():
                 row[label] = float(cross_val_score(make(), Xtr, ytr, cv=splits).mean())
             model = make().fit(Xtr, ytr)
