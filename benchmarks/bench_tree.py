@@ -608,6 +608,67 @@ LAYER_NOTES = (
 )
 
 
+def stacking_study(quick):
+    """MotionTreeHMM's per-layer class scores (``transform``) as features, on every data set.
+
+    CV accuracy on the training set (the recognition table's folds; for the CMU
+    windows also contiguous 5-fold, whose folds do not share overlapping
+    windows) and test accuracy and log loss of: the HMM alone, the HMM stacked
+    on a logistic regression (out-of-fold ``fit_transform`` rows, or in-sample
+    ``fit().transform()`` rows), the encoder pipeline, and both features side
+    by side (FeatureUnion). Only with ``--only stacking``.
+    """
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.model_selection import StratifiedKFold
+    from sklearn.pipeline import make_union
+
+    class InSample(MotionTreeHMM):  # the training rows a plain fit().transform() gives
+        def fit_transform(self, X, y, groups=None):
+            return self.fit(X, y).transform(X)
+
+    lr = lambda: LogisticRegression(max_iter=5000)  # noqa: E731
+    candidates = {
+        "MotionTreeHMM()": MotionTreeHMM,
+        "MotionTreeHMM() -> LR, out-of-fold rows": lambda: make_pipeline(MotionTreeHMM(), lr()),
+        "MotionTreeHMM() -> LR, in-sample rows": lambda: make_pipeline(InSample(), lr()),
+        "MotionTreeEncoder() -> LR": encoder_pipeline,
+        "[MotionTreeEncoder(), MotionTreeHMM()] -> LR": lambda: make_pipeline(
+            make_union(MotionTreeEncoder(), MotionTreeHMM()), lr()
+        ),
+    }
+    datasets = {"synthetic": synthetic, "synthetic positions": synthetic_positions}
+    if (SHARED_DATA / "uea").is_dir():
+        datasets = {k: lambda k=k: uea(k) for k in ("BasicMotions", "JapaneseVowels")} | datasets
+    if (SHARED_DATA / "cmu-asfamc").is_dir():
+        datasets["CMU 02 windows"] = cmu_windows
+    rows = []
+    for name, loader in datasets.items():
+        Xtr, ytr, Xte, yte, groups = loader()
+        folds = {"CV (recognition folds)": list(cv_for(ytr, groups, quick).split(Xtr, ytr, groups))}
+        if name.startswith("CMU"):
+            folds["CV (contiguous 5-fold)"] = list(StratifiedKFold(5).split(Xtr, ytr))
+        for method, make in candidates.items():
+            row = {"dataset": name, "method": method, "CV (contiguous 5-fold)": ""}
+            for label, splits in folds.items():
+                row[label] = float(cross_val_score(make(), Xtr, ytr, cv=splits).mean())
+            model = make().fit(Xtr, ytr)
+            loss, _ = probability_scores(yte, model.predict_proba(Xte), model.classes_)
+            row.update({"test accuracy": float(model.score(Xte, yte)), "test log loss": loss})
+            rows.append(row)
+    return rows
+
+
+STACKING_NOTES = (
+    "MotionTreeHMM.transform: per scored layer, the log-softmax over classes of the clip's "
+    "log generation probability per frame; stacked into LogisticRegression(C=1). 'out-of-fold "
+    "rows': the training features come from fit_transform (graphs counted without the clip's "
+    "internal fold, as StackingClassifier's cross_val_predict); 'in-sample': fit().transform(). "
+    "All defaults, nothing tuned; the choice between candidates is by training CV (on CMU by the "
+    "contiguous folds: the recognition folds share overlapping windows); the test columns are "
+    "reported, not used to choose."
+)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--quick", action="store_true", help="small grids and sizes (a smoke run)")
@@ -621,6 +682,7 @@ def main():
             "scaling",
             "layers",
             "selection",
+            "stacking",
         ],
         help="run one table only (selection, about 25 minutes, runs only when asked)",
     )
@@ -684,6 +746,8 @@ def main():
             selection_study("JapaneseVowels", loaders["JapaneseVowels"]),
             notes=SELECTION_NOTES,
         )
+    if args.only == "stacking":
+        write_results("tree_stacking", stacking_study(args.quick), notes=STACKING_NOTES)
     if args.only in (None, "scaling"):
         write_results("tree_scaling", scaling(args.quick), notes=SCALING_NOTES)
     if args.only in (None, "layers"):

@@ -4,15 +4,18 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
-from sklearn.model_selection import StratifiedKFold
 from sklearn.utils import Bunch
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted, column_or_1d
 
-from skmotion.base import ClipEstimatorMixin
+from skmotion.base import ClipFeatureMixin, MotionTags
 from skmotion.tree._batch import decode_clips
 from skmotion.tree._calibration import (
+    class_score_features,
+    class_score_names,
     fit_temperature,
+    held_out_folds,
+    layer_class_scores,
     log_softmax_rows,
     mixture_log_density,
     per_frame,
@@ -37,7 +40,7 @@ _check_count = check_int  # the one integer check, skmotion.utils._validation
 _NOVELTY_CHUNK = 4096  # frames per block of node densities in novelty_score
 
 
-class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
+class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
     """Recognise motion clips with a binary tree of frame clusters and node transition graphs.
 
     Yamane, Yamaguchi and Nakamura's motion database: ``fit`` builds a
@@ -46,7 +49,9 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     and one graph per class (or per clip). A clip's *generation probability*
     under a graph sums the ``n_paths`` best node sequences found by the
     top-down beam Viterbi (:func:`beam_decode`); ``predict`` picks the class
-    whose graph generates the clip with the highest probability.
+    whose graph generates the clip with the highest probability, and
+    ``transform`` gives those probabilities per scored layer, per frame and
+    normalised over the classes, as features for a model stacked on it.
 
     Parameters
     ----------
@@ -112,11 +117,14 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         input's units either way.
     calibration_cv : int or None, default=3
         Folds of the internal cross-validation that fits the temperature of
-        ``predict_proba`` (stratified, shuffled with a fixed seed; at most the
-        smallest class's clip count). The tree is built once on all frames
-        (it sees no labels); each fold recounts the graphs without its
-        held-out clips and scores them. None, or a smallest class of one
-        clip, keeps ``temperature_ = 1``. Labels (``predict``) never depend on it.
+        ``predict_proba`` and gives ``fit_transform``'s out-of-fold rows
+        (stratified, each class's clips cut in the order given into contiguous
+        blocks, so overlapping windows of one take stay mostly in one fold; at
+        most the smallest class's clip count; by group when ``fit`` gets
+        ``groups``). The tree is built once on all frames (it sees no labels);
+        each fold recounts the graphs without its held-out clips and scores
+        them. None, or a smallest class of one clip, keeps ``temperature_ = 1``.
+        Labels (``predict``) never depend on it.
     verbose : int, default=0
         0 is silent; 1 or more reports the stages of ``fit`` (tree, graphs,
         calibration folds) on standard error.
@@ -255,9 +263,11 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.verbose = verbose
         self.n_jobs = n_jobs
 
+    _motion_tags = MotionTags(output_kind="table")  # transform: per-layer class scores
+
     @_fit_context(prefer_skip_nested_validation=True)
-    def fit(self, X, y):
-        """Build the tree and count the transition graphs.
+    def fit(self, X, y, groups=None):
+        """Build the tree, count the transition graphs and fit the temperature.
 
         Parameters
         ----------
@@ -265,12 +275,54 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             Training clips (or a 3-D array, or a ``(clip, frame)`` DataFrame).
         y : array-like of shape (n_clips,)
             One label per clip (any hashable type, strings included).
+        groups : array-like of shape (n_clips,), default=None
+            Group of each clip (subject, take, recording): the folds of the
+            internal cross-validation (``calibration_cv``) then never split a
+            group. Without it the folds are contiguous blocks of each class's
+            clips in the order given. Labels do not depend on it.
 
         Returns
         -------
         self : MotionTreeHMM
             The fitted model.
         """
+        self._fit(X, y, groups)
+        return self
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def fit_transform(self, X, y, groups=None):
+        """Fit, and return the training clips' class-score features, out of fold.
+
+        A training clip's transition graphs include its own transitions, so its
+        ``transform`` scores are optimistic (its class looks surer than it will
+        on new clips) and a model stacked on them learns to trust them too much.
+        As sklearn's ``StackingClassifier`` does with ``cross_val_predict``, each
+        row here comes from the internal cross-validation's graphs counted
+        without the clip's fold (the folds of ``calibration_cv`` and ``groups``;
+        the tree, built without labels, is shared). So ``fit_transform(X, y)``
+        differs from ``fit(X, y).transform(X)``; ``transform`` of new clips uses
+        the graphs of all training clips. When no folds can be made
+        (``calibration_cv=None``, a class of one clip) the rows are in-sample.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+        y : array-like of shape (n_clips,)
+        groups : array-like of shape (n_clips,), default=None
+            See ``fit``.
+
+        Returns
+        -------
+        features : ndarray of shape (n_clips, n_scored_layers * n_classes) or DataFrame
+            See ``transform``.
+        """
+        clips, log_prob = self._fit(X, y, groups)
+        if log_prob is None:
+            log_prob = self._layer_log_probs(clips)
+        return self._wrap_table(class_score_features(log_prob, [len(c) for c in clips]), clips)
+
+    def _fit(self, X, y, groups):
+        """``fit``; returns the validated clips and their held-out per-layer class scores."""
         clips = check_clips(X, estimator=self, reset=True)
         y = column_or_1d(np.asarray(check_label_types(y)), warn=True)
         if len(y) != len(clips):
@@ -315,8 +367,12 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.n_layers_ = tree.n_layers
         self.n_nodes_ = tree.n_nodes
         self._set_node_weights()
-        self.temperature_ = self._fit_temperature(clips, labels, offsets, y_index)
-        return self
+        folds = held_out_folds(y_index, groups, self.calibration_cv)
+        self.temperature_, log_prob = 1.0, None
+        if folds is not None:
+            totals, log_prob = self._held_out_scores(clips, labels, offsets, y_index, folds)
+            self.temperature_ = fit_temperature(per_frame(totals, np.diff(offsets)), y_index)
+        return clips, log_prob
 
     def _set_node_weights(self):
         """``log_node_weights_``: each node's share of the frames at ``layer_`` (novelty_score)."""
@@ -349,33 +405,33 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         )
         return global_graph, graphs, graph_classes
 
-    def _fit_temperature(self, clips, labels, offsets, y_index):
-        """The softmax temperature of ``predict_proba``, by internal cross-validation.
+    def _held_out_scores(self, clips, labels, offsets, y_index, folds):
+        """Scores of every clip by graphs counted without its fold (calibration and stacking).
 
         The tree is shared (it is built without labels); each fold recounts the
         graphs from its training clips only and scores its held-out clips.
+        Returns the class totals ``(n_clips, n_classes)`` (as ``_class_log_probs``)
+        and the per-layer scores ``(n_clips, n_classes, n_scored)``.
         """
-        n_folds = min(self.calibration_cv or 0, np.bincount(y_index).min())
-        if n_folds < 2 or len(self.classes_) < 2:
-            return 1.0
         lengths = np.diff(offsets)
-        folds = StratifiedKFold(n_folds, shuffle=True, random_state=0).split(lengths, y_index)
-        scores, truth = [], []
+        totals = np.empty((len(clips), len(self.classes_)))
+        layers = np.empty((len(clips), len(self.classes_), len(self.score_layers_)))
         for train, held_out in progress(
-            list(folds), verbose=self.verbose, desc="MotionTreeHMM: calibration folds"
+            folds, verbose=self.verbose, desc="MotionTreeHMM: calibration folds"
         ):
             keep = np.repeat(np.isin(np.arange(len(lengths)), train), lengths)
             sub_offsets = np.r_[0, np.cumsum(lengths[train])]
             guide, graphs, graph_classes = self._count_graphs(
                 self.tree_, [lab[keep] for lab in labels], sub_offsets, y_index[train]
             )
-            held = [clips[i] for i in held_out]
-            log_prob = self._class_log_probs(
-                held, exact=False, graphs=graphs, graph_classes=graph_classes, guide=guide
+            scores = self._graph_scores(
+                [clips[i] for i in held_out], exact=False, graphs=graphs, guide=guide
             )
-            scores.append(per_frame(log_prob, lengths[held_out]))
-            truth.append(y_index[held_out])
-        return fit_temperature(np.vstack(scores), np.concatenate(truth))
+            totals[held_out] = self._class_totals(scores, graph_classes)
+            layers[held_out] = layer_class_scores(
+                scores, graph_classes, len(self.classes_), self.graph == "clip"
+            )
+        return totals, layers
 
     # -- decoding ------------------------------------------------------------------
 
@@ -424,35 +480,117 @@ class MotionTreeHMM(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             n_jobs=self.n_jobs,
         )
 
-    def _class_log_probs(
-        self, clips, exact=True, prune=False, graphs=None, graph_classes=None, guide=None
-    ):
-        """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
+    def _graph_scores(self, clips, exact=True, prune=False, graphs=None, guide=None):
+        """The decoder's K-best log scores ``(n_clips, n_graphs, n_scored, n_paths)``.
 
-        The product over the scored layers. Without ``exact``, up to a constant
-        per clip (enough to rank classes). With ``prune``, ``-inf`` for classes
-        that provably do not score best. ``graphs``, ``graph_classes`` and
-        ``guide`` replace the fitted ones (calibration folds).
+        Without ``exact``, up to a constant per clip and layer (enough to rank
+        classes). With ``prune``, ``-inf`` for graphs that provably do not score
+        best. ``graphs`` and ``guide`` replace the fitted ones (calibration folds).
         """
-        if graphs is None:
-            graphs, graph_classes = self.graphs_, self.graph_classes_
+        graphs = self.graphs_ if graphs is None else graphs
         _, scores = self._decode(
             clips,
             graphs,
             self.layer_,
-            len(graph_classes),
+            graphs.n_graphs,
             score_layers=len(self.score_layers_),
             exact=exact,
             prune=prune,
             paths=False,
             guide=guide,
         )
+        return scores
+
+    def _class_totals(self, scores, graph_classes):
+        """Per-class log generation probability, the product over the scored layers."""
         per_graph = sum_of_paths(scores).sum(axis=2)
         if self.graph == "class":
             return per_graph
-        out = np.full((len(clips), len(self.classes_)), -np.inf)
+        out = np.full((len(scores), len(self.classes_)), -np.inf)
         np.maximum.at(out.T, graph_classes, per_graph.T)
         return out
+
+    def _class_log_probs(self, clips, exact=True, prune=False):
+        """Log generation probability of each clip under each class, ``(n_clips, n_classes)``.
+
+        The product over the scored layers. Without ``exact``, up to a constant
+        per clip (enough to rank classes). With ``prune``, ``-inf`` for classes
+        that provably do not score best.
+        """
+        scores = self._graph_scores(clips, exact=exact, prune=prune)
+        return self._class_totals(scores, self.graph_classes_)
+
+    def _layer_log_probs(self, clips):
+        """Per-layer class log generation probabilities ``(n_clips, n_classes, n_scored)``."""
+        return layer_class_scores(
+            self._graph_scores(clips, exact=False),
+            self.graph_classes_,
+            len(self.classes_),
+            self.graph == "clip",
+        )
+
+    def transform(self, X):
+        """Per-layer class scores: the supervised view of the tree, features for a linear model.
+
+        For each scored layer ``l`` (``score_layers_``) and class ``c``:
+        ``log softmax_c(log P_l(clip | c) / n_frames)``, where ``P_l(clip | c)``
+        is the clip's generation probability under class ``c``'s graph at layer
+        ``l`` (the summed probability of its ``n_paths`` best node sequences, the
+        factor of that layer in ``score_samples``). Dividing by the clip's
+        length makes clips of any length comparable; the softmax over classes
+        within each layer makes each layer's block a log posterior under a
+        uniform class prior (at temperature 1). With ``graph="clip"``, a class's
+        score at a layer is that of its best training clip at that layer. Use
+        it to stack: ``make_pipeline(MotionTreeHMM(), LogisticRegression())``
+        learns how much to trust each layer; ``fit_transform`` gives out-of-fold
+        rows for the training clips.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        features : ndarray of shape (n_clips, n_scored_layers * n_classes)
+            Layer-major: all classes of the first scored layer, then the next
+            (``get_feature_names_out``); a DataFrame after
+            ``set_output(transform="pandas")``.
+
+        Examples
+        --------
+        >>> from sklearn.linear_model import LogisticRegression
+        >>> from sklearn.pipeline import make_pipeline
+        >>> from skmotion.datasets import make_motions
+        >>> from skmotion.tree import MotionTreeHMM
+        >>> data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+        >>> X = [clip[:, 6:] for clip in data.clips]
+        >>> model = MotionTreeHMM(max_depth=3).fit(X, data.target)
+        >>> model.transform(X).shape, list(model.get_feature_names_out()[:2])
+        ((8, 6), ['layer1_class_0', 'layer1_class_1'])
+        >>> stacked = make_pipeline(MotionTreeHMM(max_depth=3), LogisticRegression())
+        >>> stacked.fit(X, data.target).score(X, data.target)
+        1.0
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        features = class_score_features(self._layer_log_probs(clips), [len(c) for c in clips])
+        return self._wrap_table(features, clips)
+
+    def get_feature_names_out(self, input_features=None):
+        """Column names of ``transform``: ``layer<l>_class_<label>``, layer-major.
+
+        Parameters
+        ----------
+        input_features : array-like of str, default=None
+            Ignored (the columns do not follow the input channels); accepted
+            for sklearn's API.
+
+        Returns
+        -------
+        feature_names_out : ndarray of str
+        """
+        check_is_fitted(self)
+        return class_score_names(self.score_layers_, self.classes_)
 
     def score_samples(self, X):
         """Log generation probability of each clip under each class.
