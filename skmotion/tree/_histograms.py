@@ -9,7 +9,7 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["feature_blocks", "histogram_features", "residual_features"]
+__all__ = ["feature_blocks", "histogram_features", "moment_features", "residual_features"]
 
 
 def feature_blocks(layers, n_nodes, pyramid, transition_layers):
@@ -139,3 +139,38 @@ def residual_features(frames, nodes, offsets, means, center, scale, power):
         norm = np.linalg.norm(block, axis=1, keepdims=True)
         blocks.append(block / np.where(norm > 0, norm, 1.0))
     return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))
+
+
+def moment_features(frames, offsets, center, scale, order):
+    """Per clip, the mean and mean square of every channel in units of the training frames.
+
+    With ``z = (x - center) / scale`` (``center``, ``scale``: the training
+    frames' mean and standard deviation, the tree's root node), moment 1 is
+    ``mean_t z_t`` and moment 2 is ``mean_t z_t ** 2 - 1``, per channel: the
+    root's first- and second-order Fisher-vector terms (without their constant
+    factors), not power-normalised nor scaled to unit norm, so a clip far from
+    the training mean keeps its distance. They say where a clip sits and how
+    much it moves, the coarse description the residuals of the nodes leave out
+    (each of their blocks is scaled to unit norm).
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, n_channels)
+        Raw frames.
+    offsets : ndarray of shape (n_clips + 1,)
+        Clip ``i`` is frames ``offsets[i]:offsets[i + 1]`` (none empty).
+    center, scale : ndarray of shape (n_channels,)
+    order : int
+        1 (means) or 2 (means, then mean squares).
+
+    Returns
+    -------
+    features : ndarray of shape (n_clips, order * n_channels)
+    """
+    lengths = np.diff(offsets)[:, None]
+    z = (frames - center) / scale
+    blocks = [np.add.reduceat(z, offsets[:-1], axis=0) / lengths]
+    if order >= 2:
+        np.square(z, out=z)
+        blocks.append(np.add.reduceat(z, offsets[:-1], axis=0) / lengths - 1.0)
+    return np.hstack(blocks)

@@ -95,11 +95,21 @@ def reference_features(encoder, clips):
                 block[nodes[t]] += (z[t] - means[nodes[t]]) / n
             block = np.sign(block) * np.abs(block) ** encoder.power
             residuals.append(block.ravel() / np.linalg.norm(block))
-        rows.append(np.concatenate([hist, *residuals]))
+        # moments: a loop over the clip's frames in units of the training frames
+        moments = []
+        if encoder.moments:
+            total, squares = np.zeros(clip.shape[1]), np.zeros(clip.shape[1])
+            for frame in clip:
+                u = (frame - encoder.moment_center_) / encoder.moment_scale_
+                total += u
+                squares += u * u
+            moments = [total / n, squares / n - 1][: encoder.moments]
+        rows.append(np.concatenate([hist, *residuals, *moments]))
     return np.array(rows)
 
 
-def test_features_match_a_per_clip_loop(motions):
+@pytest.mark.parametrize("moments", [0, 1, 2])
+def test_features_match_a_per_clip_loop(motions, moments):
     X = motions[0][:12]
     X = X + [X[0][:2], X[1][:1]]  # clips shorter than the pyramid's cells
     encoder = MotionTreeEncoder(
@@ -108,10 +118,26 @@ def test_features_match_a_per_clip_loop(motions):
         pyramid=[1, 2, 3],
         transition_layers=[2],
         residual_layers=[1, 3],
+        moments=moments,
         power=0.5,
         sparse_output=False,
     ).fit(X)
     np.testing.assert_allclose(encoder.transform(X), reference_features(encoder, X), atol=1e-12)
+
+
+@pytest.mark.parametrize("standardize", [True, False])
+def test_moments_by_hand(standardize):
+    # Training frames 0, 2, 4, 6 and 1, 1, 1, 1: means 3 and 1, deviations sqrt(5) and 0 (taken
+    # as 1). The clip's first channel at 3 and 3 + sqrt(5) is at 0 and 1 in those units: mean
+    # 0.5, mean square 0.5 (minus 1: -0.5); its second at 1 and 3: mean 1, mean square 2 (1).
+    train = [np.array([[0.0, 1.0], [2.0, 1.0]]), np.array([[4.0, 1.0], [6.0, 1.0]])]
+    encoder = MotionTreeEncoder(
+        residual_layers=(), moments=2, standardize=standardize, min_samples_leaf=1
+    ).fit(train, None)
+    clip = np.array([[3.0, 1.0], [3.0 + np.sqrt(5.0), 3.0]])
+    np.testing.assert_allclose(encoder.transform([clip]), [[0.5, 1.0, -0.5, 1.0]], atol=1e-12)
+    names = encoder.get_feature_names_out(["a", "b"]).tolist()
+    assert names == ["mean_a", "mean_b", "meansquare_a", "meansquare_b"]
 
 
 def test_each_cell_is_a_distribution_and_names_follow_the_columns(motions):
@@ -184,6 +210,7 @@ def test_cells_partition_every_clip(lengths, parts):
         layers="all",
         pyramid=[parts],
         residual_layers=[],
+        moments=0,
         power=1.0,
         sparse_output=False,
     )
@@ -199,8 +226,9 @@ def test_cells_partition_every_clip(lengths, parts):
     [
         ({"pyramid": []}, "pyramid must name"),
         ({"pyramid": [0]}, "pyramid must hold ints >= 1"),
-        ({"layers": [9], "residual_layers": []}, "nothing to encode"),
-        ({"layers": [], "residual_layers": []}, "nothing to encode"),
+        ({"layers": [9], "residual_layers": [], "moments": 0}, "nothing to encode"),
+        ({"layers": [], "residual_layers": [], "moments": 0}, "nothing to encode"),
+        ({"moments": 3}, "moments"),
     ],
 )
 def test_bad_parameters_are_named(params, match, motions):
