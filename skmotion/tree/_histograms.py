@@ -167,10 +167,16 @@ def moment_features(frames, offsets, center, scale, order):
     -------
     features : ndarray of shape (n_clips, order * n_channels)
     """
-    lengths = np.diff(offsets)[:, None]
-    z = (frames - center) / scale
-    blocks = [np.add.reduceat(z, offsets[:-1], axis=0) / lengths]
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(len(lengths)), lengths)
+    average = sp.csr_matrix(
+        (1.0 / lengths[clip], (clip, np.arange(len(frames)))), shape=(len(lengths), len(frames))
+    )
+    # one centred copy, squared in place, the scale applied to the sums: a pass over a batch's
+    # frames costs as much as the sums themselves
+    centred = np.subtract(frames, center)
+    blocks = [(average @ centred) / scale]
     if order >= 2:
-        np.square(z, out=z)
-        blocks.append(np.add.reduceat(z, offsets[:-1], axis=0) / lengths - 1.0)
+        np.square(centred, out=centred)
+        blocks.append((average @ centred) / scale**2 - 1.0)
     return np.hstack(blocks)
