@@ -16,6 +16,9 @@ readout alone:
   others on bootstrap samples of them, columns concatenated (each tree's
   divided by ``sqrt(n_trees)``), as sklearn's ``RandomTreesEmbedding`` does with
   random trees;
+- ``"meansquare"``: the encoder's residuals and moments, with the mean square
+  minus 1 in place of the root mean square minus 1 (the first form of the
+  moments, measured before the square root was taken);
 - ``"graph"``: occupancy histograms of every layer smoothed over the layer's
   node transition graph (training frames' steps, rows normalised):
   ``h ((1 - a) I + a P)``, ``a = 0.5``, then square-rooted.
@@ -82,6 +85,10 @@ class TreeReadout(TransformerMixin, BaseEstimator):
                 encoder = MotionTreeEncoder(residual_layers=self.residual_layers, moments=0)
                 self.encoders_.append(encoder.fit([sample]))
             return self
+        if self.readout == "meansquare":
+            self.encoder_ = MotionTreeEncoder(residual_layers=self.residual_layers, moments=2)
+            self.encoder_.fit(X)
+            return self
         graph = self.readout == "graph"
         self.encoder_ = MotionTreeEncoder(
             layers="all" if graph else (),
@@ -114,6 +121,11 @@ class TreeReadout(TransformerMixin, BaseEstimator):
         return self
 
     def transform(self, X):
+        if self.readout == "meansquare":
+            features = self.encoder_.transform(X)
+            rms = features[:, -self.encoder_.n_features_in_ :]
+            features[:, -self.encoder_.n_features_in_ :] = (rms + 1.0) ** 2 - 1.0
+            return features
         if self.readout == "ensemble":
             blocks = [e.transform(X) for e in self.encoders_]
             return np.hstack(blocks) / np.sqrt(len(blocks))

@@ -78,13 +78,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     moments : {0, 1, 2}, default=2
         The clip's moments at the root, per channel, in units of the training
         frames (mean 0, standard deviation 1): 1 adds each channel's mean over
-        the clip, 2 also its mean square minus 1 (the root node's first- and
-        second-order Fisher-vector terms), ``moments * n_channels`` dense
-        columns after all others, neither power-normalised nor scaled to unit
-        norm. They keep where the clip sits and how much it moves, which the
-        unit-norm residual blocks lose; in the study behind the defaults they
-        lifted the CMU windows from 0.78 to 0.88 and held the other sets
-        (user guide). 0 leaves them out.
+        the clip, 2 also its root mean square minus 1 (the square root of the
+        root node's second-order Fisher-vector term), ``moments * n_channels``
+        dense columns after all others, not scaled to unit norm. They keep
+        where the clip sits and how much it moves, which the unit-norm
+        residual blocks lose; in the study behind the defaults they lifted the
+        CMU windows from 0.78 to 0.86 and held the other sets (user guide).
+        0 leaves them out.
     power : float, default=0.5
         Every histogram entry is raised to this power; 1 keeps the shares.
     standardize : bool, default=True
@@ -330,7 +330,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
 
         ``layer<l>_node<k>_part<c>of<p>`` (occupancy), ``layer<l>_node<a>_to_node<b>``
         (transitions), ``layer<l>_node<k>_<channel>`` (residuals), ``mean_<channel>``
-        and ``meansquare_<channel>`` (moments).
+        and ``rms_<channel>`` (moments).
 
         Parameters
         ----------
@@ -361,7 +361,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                 for k in range(self.tree_.n_nodes[layer])
                 for c in channels
             ]
-        for kind in ("mean", "meansquare")[: self.moments]:
+        for kind in ("mean", "rms")[: self.moments]:
             names += [f"{kind}_{c}" for c in channels]
         return np.asarray(names, dtype=object)
 

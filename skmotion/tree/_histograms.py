@@ -142,16 +142,18 @@ def residual_features(frames, nodes, offsets, means, center, scale, power):
 
 
 def moment_features(frames, offsets, center, scale, order):
-    """Per clip, the mean and mean square of every channel in units of the training frames.
+    """Per clip, the mean and root mean square of every channel in units of the training frames.
 
     With ``z = (x - center) / scale`` (``center``, ``scale``: the training
     frames' mean and standard deviation, the tree's root node), moment 1 is
-    ``mean_t z_t`` and moment 2 is ``mean_t z_t ** 2 - 1``, per channel: the
-    root's first- and second-order Fisher-vector terms (without their constant
-    factors), not power-normalised nor scaled to unit norm, so a clip far from
-    the training mean keeps its distance. They say where a clip sits and how
-    much it moves, the coarse description the residuals of the nodes leave out
-    (each of their blocks is scaled to unit norm).
+    ``mean_t z_t`` and moment 2 is ``sqrt(mean_t z_t ** 2) - 1``, per channel:
+    the root's first-order Fisher-vector term and the square root of its
+    second-order one (0 for a clip that spreads like the training frames; the
+    square root, like ``power`` elsewhere, tempers large values), not scaled
+    to unit norm, so a clip far from the training mean keeps its distance.
+    They say where a clip sits and how much it moves, the coarse description
+    the residuals of the nodes leave out (each of their blocks is scaled to
+    unit norm).
 
     Parameters
     ----------
@@ -161,7 +163,7 @@ def moment_features(frames, offsets, center, scale, order):
         Clip ``i`` is frames ``offsets[i]:offsets[i + 1]`` (none empty).
     center, scale : ndarray of shape (n_channels,)
     order : int
-        1 (means) or 2 (means, then mean squares).
+        1 (means) or 2 (means, then root mean squares).
 
     Returns
     -------
@@ -178,5 +180,5 @@ def moment_features(frames, offsets, center, scale, order):
     blocks = [(average @ centred) / scale]
     if order >= 2:
         np.square(centred, out=centred)
-        blocks.append((average @ centred) / scale**2 - 1.0)
+        blocks.append(np.sqrt(average @ centred) / scale - 1.0)
     return np.hstack(blocks)

@@ -103,7 +103,7 @@ def reference_features(encoder, clips):
                 u = (frame - encoder.moment_center_) / encoder.moment_scale_
                 total += u
                 squares += u * u
-            moments = [total / n, squares / n - 1][: encoder.moments]
+            moments = [total / n, np.sqrt(squares / n) - 1][: encoder.moments]
         rows.append(np.concatenate([hist, *residuals, *moments]))
     return np.array(rows)
 
@@ -129,15 +129,17 @@ def test_features_match_a_per_clip_loop(motions, moments):
 def test_moments_by_hand(standardize):
     # Training frames 0, 2, 4, 6 and 1, 1, 1, 1: means 3 and 1, deviations sqrt(5) and 0 (taken
     # as 1). The clip's first channel at 3 and 3 + sqrt(5) is at 0 and 1 in those units: mean
-    # 0.5, mean square 0.5 (minus 1: -0.5); its second at 1 and 3: mean 1, mean square 2 (1).
+    # 0.5, mean square 0.5, rms minus 1: sqrt(0.5) - 1; its second at 1 and 3 is at 0 and 2:
+    # mean 1, mean square 2, rms minus 1: sqrt(2) - 1.
     train = [np.array([[0.0, 1.0], [2.0, 1.0]]), np.array([[4.0, 1.0], [6.0, 1.0]])]
     encoder = MotionTreeEncoder(
         residual_layers=(), moments=2, standardize=standardize, min_samples_leaf=1
     ).fit(train, None)
     clip = np.array([[3.0, 1.0], [3.0 + np.sqrt(5.0), 3.0]])
-    np.testing.assert_allclose(encoder.transform([clip]), [[0.5, 1.0, -0.5, 1.0]], atol=1e-12)
+    expected = [[0.5, 1.0, np.sqrt(0.5) - 1, np.sqrt(2.0) - 1]]
+    np.testing.assert_allclose(encoder.transform([clip]), expected, atol=1e-12)
     names = encoder.get_feature_names_out(["a", "b"]).tolist()
-    assert names == ["mean_a", "mean_b", "meansquare_a", "meansquare_b"]
+    assert names == ["mean_a", "mean_b", "rms_a", "rms_b"]
 
 
 def test_each_cell_is_a_distribution_and_names_follow_the_columns(motions):
