@@ -12,7 +12,9 @@ from skmotion.tree._histograms import (
     feature_blocks,
     histogram_features,
     moment_features,
+    node_variances,
     residual_features,
+    second_order_features,
 )
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._routing import TreeRouter
@@ -75,6 +77,15 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         mean (standardised units, ``n_nodes * n_channels`` dense columns per
         layer; a VLAD code), each layer's block scaled to unit norm. Occupancy
         alone loses this continuous detail.
+    residual_order : {1, 2}, default=1
+        2 adds, after the residuals, their second order: per node of each
+        residual layer and channel, the mean over the clip's frames in the
+        node of ``(z - mean) ** 2 / variance - 1`` (the node's variance from
+        the training frames; a Fisher vector's variance terms), each layer's
+        block power-normalised and scaled to unit norm. In the defaults study
+        it raised the CV accuracy on JapaneseVowels (0.978 against 0.967) and
+        tied on the other sets, a margin too small to double the residual
+        columns by default (user guide).
     moments : {0, 1, 2}, default=2
         The clip's moments at the root, per channel, in units of the training
         frames (mean 0, standard deviation 1): 1 adds each channel's mean over
@@ -157,6 +168,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         "pyramid": ["array-like"],
         "transition_layers": ["array-like"],
         "residual_layers": ["array-like"],
+        "residual_order": [Interval(Integral, 1, 2, closed="both")],
         "moments": [Interval(Integral, 0, 2, closed="both")],
         "power": [Interval(Real, 0, 1, closed="right")],
         "standardize": ["boolean"],
@@ -175,6 +187,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         pyramid=(1, 2, 3),
         transition_layers=(),
         residual_layers=(1, 3),
+        residual_order=1,
         moments=2,
         power=0.5,
         standardize=True,
@@ -188,6 +201,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self.pyramid = pyramid
         self.transition_layers = transition_layers
         self.residual_layers = residual_layers
+        self.residual_order = residual_order
         self.moments = moments
         self.power = power
         self.standardize = standardize
@@ -252,8 +266,15 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             self.layers_, self.tree_.n_nodes, pyramid, self.transition_layers_
         )
         self._residual_means = [self.tree_.means(layer) for layer in self.residual_layers_]
+        self._residual_variances = []
+        if self.residual_order == 2 and len(self.residual_layers_):
+            z = (frames - self.center_) / self.scale_
+            nodes = self._router.route(frames, self.residual_layers_)
+            self._residual_variances = node_variances(z, nodes, self._residual_means)
+        orders = 2 if self._residual_variances else 1
+        n_residual = self.tree_.n_nodes[self.residual_layers_].sum() * orders
         self.n_features_out_ = sum(width for *_, width in self._blocks) + int(
-            (self.tree_.n_nodes[self.residual_layers_].sum() + self.moments) * self.n_features_in_
+            (n_residual + self.moments) * self.n_features_in_
         )
         return self
 
@@ -298,6 +319,17 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                     self.power,
                 )
             )
+        if self._residual_variances:
+            parts.append(
+                second_order_features(
+                    (frames - self.center_) / self.scale_,
+                    nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                    offsets,
+                    self._residual_means,
+                    self._residual_variances,
+                    self.power,
+                )
+            )
         if self.moments:
             parts.append(
                 moment_features(
@@ -329,7 +361,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         """Column names: each names its layer, node and pyramid cell (or step, or channel).
 
         ``layer<l>_node<k>_part<c>of<p>`` (occupancy), ``layer<l>_node<a>_to_node<b>``
-        (transitions), ``layer<l>_node<k>_<channel>`` (residuals), ``mean_<channel>``
+        (transitions), ``layer<l>_node<k>_<channel>`` (residuals),
+        ``layer<l>_node<k>_var_<channel>`` (their second order), ``mean_<channel>``
         and ``rms_<channel>`` (moments).
 
         Parameters
@@ -358,6 +391,12 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         for layer in self.residual_layers_:
             names += [
                 f"layer{layer}_node{k}_{c}"
+                for k in range(self.tree_.n_nodes[layer])
+                for c in channels
+            ]
+        for layer in self.residual_layers_ if self._residual_variances else ():
+            names += [
+                f"layer{layer}_node{k}_var_{c}"
                 for k in range(self.tree_.n_nodes[layer])
                 for c in channels
             ]

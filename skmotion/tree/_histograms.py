@@ -9,7 +9,14 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["feature_blocks", "histogram_features", "moment_features", "residual_features"]
+__all__ = [
+    "feature_blocks",
+    "histogram_features",
+    "moment_features",
+    "node_variances",
+    "residual_features",
+    "second_order_features",
+]
 
 
 def feature_blocks(layers, n_nodes, pyramid, transition_layers):
@@ -182,3 +189,65 @@ def moment_features(frames, offsets, center, scale, order):
         np.square(centred, out=centred)
         blocks.append(np.sqrt(average @ centred) / scale - 1.0)
     return np.hstack(blocks)
+
+
+def _node_averages(values, nodes, offsets, k):
+    """Per clip and node, the sum of ``values`` over the clip's frames in the node / its frames."""
+    n_clips, n_frames = len(offsets) - 1, len(values)
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(n_clips), lengths)
+    group = clip * k + nodes
+    average = sp.csr_matrix(
+        (1.0 / lengths[clip], (group, np.arange(n_frames))), shape=(n_clips * k, n_frames)
+    )
+    return (average @ values).reshape(n_clips, -1)
+
+
+def node_variances(z, nodes, means):
+    """Each node's per-channel variance of the standardised frames ``z`` routed to it.
+
+    1 where a node holds fewer than two frames; at least 1e-3 (a floor against
+    division by a node whose frames agree in a channel).
+    """
+    variances = []
+    for j, mean in enumerate(means):
+        node = nodes[:, j]
+        count = np.bincount(node, minlength=len(mean))[:, None]
+        squares = np.zeros_like(mean)
+        np.add.at(squares, node, (z - mean[node]) ** 2)
+        spread = np.maximum(squares / np.maximum(count, 1), 1e-3)
+        variances.append(np.where(count > 1, spread, 1.0))
+    return variances
+
+
+def second_order_features(z, nodes, offsets, means, variances, power):
+    """Per clip and node, the mean of ``(z - mean) ** 2 / variance - 1`` over its frames there.
+
+    A Fisher vector's variance terms over a layer's nodes (without their
+    constant factors): how much more or less the clip's frames spread within
+    each node than the training frames did. Each layer's block is raised to
+    ``power`` with its sign and scaled to unit norm, like the residuals.
+
+    Parameters
+    ----------
+    z : ndarray of shape (n_frames, n_channels)
+        Standardised frames.
+    nodes, offsets, means : as for :func:`residual_features`
+    variances : list of ndarray of shape (n_nodes(layer), n_channels)
+        From :func:`node_variances` on the training frames.
+    power : float
+
+    Returns
+    -------
+    features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
+    """
+    blocks = []
+    for j, (mean, variance) in enumerate(zip(means, variances)):
+        node = nodes[:, j]
+        terms = (z - mean[node]) ** 2 / variance[node] - 1.0
+        block = _node_averages(terms, node, offsets, len(mean))
+        if power != 1:
+            block = np.sign(block) * np.abs(block) ** power
+        norm = np.linalg.norm(block, axis=1, keepdims=True)
+        blocks.append(block / np.where(norm > 0, norm, 1.0))
+    return np.hstack(blocks) if blocks else np.zeros((len(offsets) - 1, 0))

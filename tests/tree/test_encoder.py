@@ -59,10 +59,27 @@ def test_routing_matches_the_trees_splits_at_every_layer(split, rng):
     np.testing.assert_array_equal(some, routed[:, [2, 5]])
 
 
-def reference_features(encoder, clips):
+def reference_variances(encoder, train):
+    """Each residual node's per-channel variance of its training frames, by a loop over nodes."""
+    if encoder.residual_order == 1:
+        return []
+    z = (np.vstack(train) - encoder.center_) / encoder.scale_
+    variances = []
+    for layer in encoder.residual_layers_:
+        nodes = encoder.tree_.apply(z, layer)
+        variance = np.ones((encoder.tree_.n_nodes[layer], z.shape[1]))
+        for k in range(len(variance)):
+            if (nodes == k).sum() > 1:
+                variance[k] = np.maximum(z[nodes == k].var(axis=0), 1e-3)
+        variances.append(variance)
+    return variances
+
+
+def reference_features(encoder, clips, train=None):
     """The encoding by a loop over clips, frames and cells (an independent computation)."""
     rows = []
     tree = encoder.tree_
+    variances = reference_variances(encoder, clips if train is None else train)
     for clip in clips:
         z = (clip - encoder.center_) / encoder.scale_
         n = len(clip)
@@ -95,6 +112,14 @@ def reference_features(encoder, clips):
                 block[nodes[t]] += (z[t] - means[nodes[t]]) / n
             block = np.sign(block) * np.abs(block) ** encoder.power
             residuals.append(block.ravel() / np.linalg.norm(block))
+        for layer, variance in zip(encoder.residual_layers_, variances):
+            nodes = tree.apply(z, layer)
+            means = tree.means(layer)
+            block = np.zeros_like(means)
+            for t in range(n):
+                block[nodes[t]] += ((z[t] - means[nodes[t]]) ** 2 / variance[nodes[t]] - 1) / n
+            block = np.sign(block) * np.abs(block) ** encoder.power
+            residuals.append(block.ravel() / np.linalg.norm(block))
         # moments: a loop over the clip's frames in units of the training frames
         moments = []
         if encoder.moments:
@@ -108,8 +133,8 @@ def reference_features(encoder, clips):
     return np.array(rows)
 
 
-@pytest.mark.parametrize("moments", [0, 1, 2])
-def test_features_match_a_per_clip_loop(motions, moments):
+@pytest.mark.parametrize("moments, residual_order", [(0, 1), (1, 1), (2, 1), (2, 2)])
+def test_features_match_a_per_clip_loop(motions, moments, residual_order):
     X = motions[0][:12]
     X = X + [X[0][:2], X[1][:1]]  # clips shorter than the pyramid's cells
     encoder = MotionTreeEncoder(
@@ -118,11 +143,19 @@ def test_features_match_a_per_clip_loop(motions, moments):
         pyramid=[1, 2, 3],
         transition_layers=[2],
         residual_layers=[1, 3],
+        residual_order=residual_order,
         moments=moments,
         power=0.5,
         sparse_output=False,
     ).fit(X)
-    np.testing.assert_allclose(encoder.transform(X), reference_features(encoder, X), atol=1e-12)
+    features = encoder.transform(X)
+    np.testing.assert_allclose(features, reference_features(encoder, X), atol=1e-12)
+    names = encoder.get_feature_names_out()
+    assert len(names) == features.shape[1] == encoder.n_features_out_
+    last = {0: "layer3_node7_channel_59", 1: "mean_channel_59", 2: "rms_channel_59"}[moments]
+    assert names[-1] == last
+    if residual_order == 2:
+        assert "layer3_node7_var_channel_59" in names
 
 
 @pytest.mark.parametrize("standardize", [True, False])
