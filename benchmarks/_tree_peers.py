@@ -136,7 +136,7 @@ ENCODER_CANDIDATES = {
     "residuals 1, 3 + mean, mean square": dict(readout="meansquare"),
     "residuals 1, 3 + mean, root mean square (defaults)": dict(),
     "defaults, soft assignment (T = 1)": dict(readout="soft", moments=2),
-    "defaults + second order (Fisher)": dict(readout="fisher", moments=2),
+    "defaults + second order (Fisher)": dict(residual_order=2),
     "defaults, 5 trees (bootstrap)": dict(readout="ensemble", moments=2),
     "defaults, LogisticRegression(C=10)": dict(C=10.0),
     "defaults, StandardScaler + RidgeClassifierCV": dict(classifier="ridge"),
