@@ -42,9 +42,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     of its steps from node to node (transitions), all raised to ``power``
     (0.5: the Hellinger map, which stabilises the variance of small shares),
     and, by default, where its frames sit within the nodes of two layers
-    (residuals) and the mean and mean square of each channel over the clip
-    (moments). A linear classifier on these vectors is the recommended recogniser on
-    multi-subject data::
+    (residuals) and the mean and root mean square of each channel over the
+    clip (moments). A linear classifier on these vectors is the recommended
+    recogniser on multi-subject data::
 
         make_pipeline(VirtualMarkerTransform(...), MotionTreeEncoder(), LogisticRegression())
 
