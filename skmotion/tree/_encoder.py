@@ -322,11 +322,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         if self._residual_variances:
             parts.append(
                 second_order_features(
-                    (frames - self.center_) / self.scale_,
+                    frames,
                     nodes[:, np.searchsorted(routed, self.residual_layers_)],
                     offsets,
                     self._residual_means,
                     self._residual_variances,
+                    self.center_,
+                    self.scale_,
                     self.power,
                 )
             )

@@ -192,15 +192,19 @@ def moment_features(frames, offsets, center, scale, order):
 
 
 def _node_averages(values, nodes, offsets, k):
-    """Per clip and node, the sum of ``values`` over the clip's frames in the node / its frames."""
-    n_clips, n_frames = len(offsets) - 1, len(values)
+    """Per clip and node: the sums of ``values`` over the clip's frames in the node / its frames.
+
+    ``values`` is a list of arrays of shape (n_frames, n_channels), summed by one
+    sparse (clip, node) x frame matrix; also returns each group's share of its clip's frames.
+    """
+    n_clips, n_frames = len(offsets) - 1, len(nodes)
     lengths = np.diff(offsets)
     clip = np.repeat(np.arange(n_clips), lengths)
+    weight = 1.0 / lengths[clip]
     group = clip * k + nodes
-    average = sp.csr_matrix(
-        (1.0 / lengths[clip], (group, np.arange(n_frames))), shape=(n_clips * k, n_frames)
-    )
-    return (average @ values).reshape(n_clips, -1)
+    average = sp.csr_matrix((weight, (group, np.arange(n_frames))), shape=(n_clips * k, n_frames))
+    share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
+    return [average @ v for v in values], share
 
 
 def node_variances(z, nodes, means):
@@ -220,34 +224,42 @@ def node_variances(z, nodes, means):
     return variances
 
 
-def second_order_features(z, nodes, offsets, means, variances, power):
+def second_order_features(frames, nodes, offsets, means, variances, center, scale, power):
     """Per clip and node, the mean of ``(z - mean) ** 2 / variance - 1`` over its frames there.
 
     A Fisher vector's variance terms over a layer's nodes (without their
-    constant factors): how much more or less the clip's frames spread within
-    each node than the training frames did. Each layer's block is raised to
-    ``power`` with its sign and scaled to unit norm, like the residuals.
+    constant factors), with ``z = (x - center) / scale``: how much more or less
+    the clip's frames spread within each node than the training frames did.
+    Each layer's block is raised to ``power`` with its sign and scaled to unit
+    norm, like the residuals.
 
     Parameters
     ----------
-    z : ndarray of shape (n_frames, n_channels)
-        Standardised frames.
-    nodes, offsets, means : as for :func:`residual_features`
+    frames : ndarray of shape (n_frames, n_channels)
+        Raw frames.
+    nodes, offsets, means, center, scale, power : as for :func:`residual_features`
     variances : list of ndarray of shape (n_nodes(layer), n_channels)
         From :func:`node_variances` on the training frames.
-    power : float
 
     Returns
     -------
     features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
     """
+    n_clips = len(offsets) - 1
+    # sum (z - m)^2 = sum z^2 - 2 m sum z + share m^2 per group: two sparse sums of one centred
+    # copy per layer, no per-frame gather of the node's mean (z and m are in standardised units,
+    # a few at most, so the expansion loses nothing that matters)
+    centred = np.subtract(frames, center)
+    squares = centred * centred
     blocks = []
     for j, (mean, variance) in enumerate(zip(means, variances)):
-        node = nodes[:, j]
-        terms = (z - mean[node]) ** 2 / variance[node] - 1.0
-        block = _node_averages(terms, node, offsets, len(mean))
+        k = len(mean)
+        (first, second), share = _node_averages([centred, squares], nodes[:, j], offsets, k)
+        mean_rows, variance_rows = np.tile(mean, (n_clips, 1)), np.tile(variance, (n_clips, 1))
+        spread = second / scale**2 - 2 * mean_rows * first / scale + share * mean_rows**2
+        block = (spread / variance_rows - share).reshape(n_clips, -1)
         if power != 1:
             block = np.sign(block) * np.abs(block) ** power
         norm = np.linalg.norm(block, axis=1, keepdims=True)
         blocks.append(block / np.where(norm > 0, norm, 1.0))
-    return np.hstack(blocks) if blocks else np.zeros((len(offsets) - 1, 0))
+    return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))
