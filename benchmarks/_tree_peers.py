@@ -1,10 +1,12 @@
 """Peers and measures of bench_tree.py's recognition tables: MiniRocket, calibration, defaults."""
 
 import numpy as np
-from sklearn.linear_model import LogisticRegression
+from _tree_readouts import TreeReadout  # benchmarks/ is on the path
+from sklearn.linear_model import LogisticRegression, RidgeClassifierCV
 from sklearn.metrics import log_loss
 from sklearn.model_selection import cross_val_score
 from sklearn.pipeline import make_pipeline
+from sklearn.preprocessing import StandardScaler
 
 from skmotion.preprocessing import ResampleClips
 from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
@@ -12,18 +14,30 @@ from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
 ENCODER_GRID = {
     "motiontreeencoder__layers": [(), "all"],
     "motiontreeencoder__residual_layers": [(1, 3), (0, 1, 2, 3), (2, 4)],
+    "motiontreeencoder__moments": [2, 1, 0],
     "logisticregression__C": [1.0, 10.0],
 }
 QUICK_ENCODER_GRID = {
     "motiontreeencoder__residual_layers": [(1, 3), (0, 1, 2, 3)],
+    "motiontreeencoder__moments": [2, 0],
     "logisticregression__C": [1.0, 10.0],
 }
 
 
 def encoder_pipeline(**params):
-    """The recommended recogniser: the tree's histograms and residuals, a logistic regression."""
+    """The recommended recogniser: the tree's histograms and residuals, a logistic regression.
+
+    For the defaults study, ``readout`` swaps the encoder for a candidate
+    :class:`TreeReadout` and ``classifier="ridge"`` the logistic regression for
+    MiniRocket's classifier (standardised columns, ``RidgeClassifierCV``).
+    """
+    params = dict(params)
     C = params.pop("C", 1.0)
-    return make_pipeline(MotionTreeEncoder(**params), LogisticRegression(C=C, max_iter=5000))
+    classifier = LogisticRegression(C=C, max_iter=5000)
+    if params.pop("classifier", None) == "ridge":
+        classifier = make_pipeline(StandardScaler(), RidgeClassifierCV(np.logspace(-3, 3, 10)))
+    encoder = TreeReadout(**params) if "readout" in params else MotionTreeEncoder(**params)
+    return make_pipeline(encoder, classifier)
 
 
 class MiniRocket:
@@ -101,19 +115,36 @@ HMM_CANDIDATES = {
         split="two_means", max_depth=8, score_layers=3, min_samples_leaf=4
     ),
 }
+# "moments" is 2 by default: the candidates without it say moments=0.
 ENCODER_CANDIDATES = {
-    "occupancy, depth 8, pyramid 1-2-3": dict(layers="all", residual_layers=()),
-    "occupancy, depth 8, pyramid 1": dict(layers="all", pyramid=(1,), residual_layers=()),
-    "occupancy depth 8, pyramid 1-2-3 + residuals 1, 3": dict(layers="all"),
-    "occupancy depth 8, pyramid 1 + residuals 1, 3": dict(layers="all", pyramid=(1,)),
-    "residuals of layers 1, 3 (defaults)": dict(),
-    "residuals of layers 0-3": dict(residual_layers=(0, 1, 2, 3)),
-    "residuals of layers 2, 4": dict(residual_layers=(2, 4)),
+    "occupancy, depth 8, pyramid 1-2-3": dict(layers="all", residual_layers=(), moments=0),
+    "occupancy, depth 8, pyramid 1": dict(
+        layers="all", pyramid=(1,), residual_layers=(), moments=0
+    ),
+    "occupancy, depth 8, graph-smoothed (a = 0.5)": dict(readout="graph"),
+    "occupancy depth 8, pyramid 1-2-3 + residuals 1, 3": dict(layers="all", moments=0),
+    "occupancy depth 8, pyramid 1 + residuals 1, 3": dict(layers="all", pyramid=(1,), moments=0),
+    "residuals of layers 1, 3 (former defaults)": dict(moments=0),
+    "residuals of layers 0-3": dict(residual_layers=(0, 1, 2, 3), moments=0),
+    "residuals of layers 2, 4": dict(residual_layers=(2, 4), moments=0),
+    "residuals 1, 3, soft assignment (T = 1)": dict(readout="soft"),
+    "residuals 1, 3 + second order (Fisher)": dict(readout="fisher"),
+    "residuals 1, 3, pyramid 1-2-3": dict(readout="pyramid"),
+    "residuals 1, 3, 5 trees (bootstrap)": dict(readout="ensemble"),
+    "moments 1, 2 alone": dict(residual_layers=(), moments=2),
+    "residuals 1, 3 + moment 1": dict(moments=1),
+    "residuals 1, 3 + mean, mean square": dict(readout="meansquare"),
+    "residuals 1, 3 + mean, root mean square (defaults)": dict(),
+    "defaults, soft assignment (T = 1)": dict(readout="soft", moments=2),
+    "defaults + second order (Fisher)": dict(residual_order=2),
+    "defaults, 5 trees (bootstrap)": dict(readout="ensemble", moments=2),
+    "defaults, LogisticRegression(C=10)": dict(C=10.0),
+    "defaults, StandardScaler + RidgeClassifierCV": dict(classifier="ridge"),
 }
 
 
 def defaults_study(name, data, splits, quick):
-    """Test accuracy (and, unless quick, CV accuracy on training) of each candidate default."""
+    """Test and CV accuracy of each candidate default (MotionTreeHMM: no CV in a quick run)."""
     Xtr, ytr, Xte, yte, _ = data
     rows = []
     candidates = [("MotionTreeHMM", k, v) for k, v in HMM_CANDIDATES.items()]
@@ -125,7 +156,8 @@ def defaults_study(name, data, splits, quick):
             model = MotionTreeHMM(calibration_cv=None, **params)
         else:
             model = encoder_pipeline(**params)
-        cv = "" if quick else float(cross_val_score(model, Xtr, ytr, cv=splits, n_jobs=2).mean())
+        skip_cv = quick and model_name == "MotionTreeHMM"
+        cv = "" if skip_cv else float(cross_val_score(model, Xtr, ytr, cv=splits, n_jobs=2).mean())
         rows.append(
             {
                 "dataset": name,

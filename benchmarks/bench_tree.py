@@ -551,8 +551,9 @@ RECOGNITION_NOTES = (
     "repeated three times unless --quick, the same splits for every model; subject-wise 3-fold "
     "for the synthetic data): MotionTreeHMM by GridSearchCV over n_paths, score_layers, split, "
     "max_depth, min_samples_leaf, covariance_type and smoothing (on CMU a smaller grid; --quick: "
-    "split, max_depth, covariance_type); the encoder pipeline over layers, residual_layers and "
-    "LogisticRegression's C (--quick: residual_layers and C); hmmlearn's state count; "
+    "split, max_depth, covariance_type); the encoder pipeline over layers, residual_layers, "
+    "moments and LogisticRegression's C (--quick: residual_layers, moments and C); hmmlearn's "
+    "state count; "
     "MiniRocket: default kernels, its ridge's alpha by leave-one-out on the training set. "
     "Probabilities: MotionTreeHMM's predict_proba (temperature fitted by internal CV), the "
     "encoder's LogisticRegression, hmmlearn's softmax of per-class log-likelihoods, MiniRocket's "
@@ -567,9 +568,12 @@ RECOGNITION_NOTES = (
 )
 DEFAULTS_NOTES = (
     "Candidate defaults of MotionTreeHMM (calibration_cv=None: labels do not depend on it) and of "
-    "MotionTreeEncoder (into LogisticRegression(C=1)): accuracy by cross-validation on the "
-    "training set "
-    "(the recognition table's folds; not in the quick run) and on the test set."
+    "MotionTreeEncoder (into LogisticRegression(C=1) unless the candidate says otherwise): "
+    "accuracy by cross-validation on the training set (the recognition table's folds; for "
+    "MotionTreeHMM not in the quick run) and on the test set. Candidate readouts that skmotion "
+    "does not offer (soft assignment, second order, residual pyramid, bootstrap trees, "
+    "graph-smoothed occupancy, the mean-square moments) are in benchmarks/_tree_readouts.py, "
+    "on the same tree and routing."
 )
 ENCODER_SPEED_NOTES = (
     "MotionTreeEncoder() fit on 40-frame windows (hop 20) of the synthetic motions' first 20 "

@@ -8,7 +8,14 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
-from skmotion.tree._histograms import feature_blocks, histogram_features, residual_features
+from skmotion.tree._histograms import (
+    feature_blocks,
+    histogram_features,
+    moment_features,
+    node_variances,
+    residual_features,
+    second_order_features,
+)
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._routing import TreeRouter
 from skmotion.tree._split import SPLIT_CRITERIA
@@ -33,9 +40,11 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     frames in each node (occupancy), also over the halves, thirds, ... of the
     clip (a temporal pyramid: *when* a pose occurs), optionally with the shares
     of its steps from node to node (transitions), all raised to ``power``
-    (0.5: the Hellinger map, which stabilises the variance of small shares). A
-    linear classifier on these vectors is the recommended recogniser on
-    multi-subject data::
+    (0.5: the Hellinger map, which stabilises the variance of small shares),
+    and, by default, where its frames sit within the nodes of two layers
+    (residuals) and the mean and root mean square of each channel over the
+    clip (moments). A linear classifier on these vectors is the recommended
+    recogniser on multi-subject data::
 
         make_pipeline(VirtualMarkerTransform(...), MotionTreeEncoder(), LogisticRegression())
 
@@ -68,6 +77,25 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         mean (standardised units, ``n_nodes * n_channels`` dense columns per
         layer; a VLAD code), each layer's block scaled to unit norm. Occupancy
         alone loses this continuous detail.
+    residual_order : {1, 2}, default=1
+        2 adds, after the residuals, their second order: per node of each
+        residual layer and channel, the mean over the clip's frames in the
+        node of ``(z - mean) ** 2 / variance - 1`` (the node's variance from
+        the training frames; a Fisher vector's variance terms), each layer's
+        block power-normalised and scaled to unit norm. In the defaults study
+        it raised the CV accuracy on JapaneseVowels (0.978 against 0.967) and
+        tied on the other sets, a margin too small to double the residual
+        columns by default (user guide).
+    moments : {0, 1, 2}, default=2
+        The clip's moments at the root, per channel, in units of the training
+        frames (mean 0, standard deviation 1): 1 adds each channel's mean over
+        the clip, 2 also its root mean square minus 1 (the square root of the
+        root node's second-order Fisher-vector term), ``moments * n_channels``
+        dense columns after all others, not scaled to unit norm. They keep
+        where the clip sits and how much it moves, which the unit-norm
+        residual blocks lose; in the study behind the defaults they lifted the
+        CMU windows from 0.78 to 0.86 and held the other sets (user guide).
+        0 leaves them out.
     power : float, default=0.5
         Every histogram entry is raised to this power; 1 keeps the shares.
     standardize : bool, default=True
@@ -91,6 +119,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         The layers whose transitions are encoded.
     residual_layers_ : ndarray of int
         The layers whose residuals are encoded.
+    moment_center_, moment_scale_ : ndarray of shape (n_features_in_,)
+        The training frames' mean and standard deviation (1 where it is 0),
+        the units of the moments.
     center_, scale_ : ndarray of shape (n_features_in_,)
         The standardisation.
     n_features_out_ : int
@@ -123,7 +154,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     >>> encoder = MotionTreeEncoder(max_depth=3, layers="all", pyramid=[1, 2], residual_layers=[1])
     >>> encoder = encoder.fit(X)
     >>> encoder.transform(X).shape, encoder.get_feature_names_out()[:2].tolist()
-    ((8, 162), ['layer1_node0_part1of1', 'layer1_node1_part1of1'])
+    ((8, 282), ['layer1_node0_part1of1', 'layer1_node1_part1of1'])
     >>> model = make_pipeline(MotionTreeEncoder(), LogisticRegression()).fit(X, data.target)
     >>> model.score(X, data.target)
     1.0
@@ -137,6 +168,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         "pyramid": ["array-like"],
         "transition_layers": ["array-like"],
         "residual_layers": ["array-like"],
+        "residual_order": [Interval(Integral, 1, 2, closed="both")],
+        "moments": [Interval(Integral, 0, 2, closed="both")],
         "power": [Interval(Real, 0, 1, closed="right")],
         "standardize": ["boolean"],
         "sparse_output": ["boolean", StrOptions({"auto"})],
@@ -154,6 +187,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         pyramid=(1, 2, 3),
         transition_layers=(),
         residual_layers=(1, 3),
+        residual_order=1,
+        moments=2,
         power=0.5,
         standardize=True,
         sparse_output="auto",
@@ -166,6 +201,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self.pyramid = pyramid
         self.transition_layers = transition_layers
         self.residual_layers = residual_layers
+        self.residual_order = residual_order
+        self.moments = moments
         self.power = power
         self.standardize = standardize
         self.sparse_output = sparse_output
@@ -192,12 +229,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             raise ValueError("pyramid must name at least one level, e.g. (1,) or (1, 2, 3).")
         clips = check_clips(X, estimator=self, reset=True)
         frames, _ = stack_clips(clips)
+        self.moment_center_ = frames.mean(axis=0)
+        spread = frames.std(axis=0)
+        self.moment_scale_ = np.where(spread > 0, spread, 1.0)
         self.center_ = np.zeros(frames.shape[1])
         self.scale_ = np.ones(frames.shape[1])
         if self.standardize:
-            self.center_ = frames.mean(axis=0)
-            spread = frames.std(axis=0)
-            self.scale_ = np.where(spread > 0, spread, 1.0)
+            self.center_, self.scale_ = self.moment_center_, self.moment_scale_
         say(self.verbose, f"MotionTreeEncoder: building the tree over {len(frames):,} frames")
         self.tree_ = MotionTree.build(
             (frames - self.center_) / self.scale_,
@@ -211,11 +249,16 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self.layers_ = np.array(sorted({v for v in wanted if v <= bottom}), dtype=np.intp)
         self.transition_layers_ = _existing("transition_layers", self.transition_layers, bottom)
         self.residual_layers_ = _existing("residual_layers", self.residual_layers, bottom)
-        if not (len(self.layers_) or len(self.transition_layers_) or len(self.residual_layers_)):
+        if not (
+            len(self.layers_)
+            or len(self.transition_layers_)
+            or len(self.residual_layers_)
+            or self.moments
+        ):
             raise ValueError(
                 f"None of layers={self.layers!r}, transition_layers={self.transition_layers!r}, "
                 f"residual_layers={self.residual_layers!r} exists in the tree (layers 0 to "
-                f"{bottom}); nothing to encode."
+                f"{bottom}) and moments=0; nothing to encode."
             )
         self._pyramid = pyramid
         self._router = TreeRouter(self.tree_, self.center_, self.scale_)
@@ -223,8 +266,15 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             self.layers_, self.tree_.n_nodes, pyramid, self.transition_layers_
         )
         self._residual_means = [self.tree_.means(layer) for layer in self.residual_layers_]
+        self._residual_variances = []
+        if self.residual_order == 2 and len(self.residual_layers_):
+            z = (frames - self.center_) / self.scale_
+            nodes = self._router.route(frames, self.residual_layers_)
+            self._residual_variances = node_variances(z, nodes, self._residual_means)
+        orders = 2 if self._residual_variances else 1
+        n_residual = self.tree_.n_nodes[self.residual_layers_].sum() * orders
         self.n_features_out_ = sum(width for *_, width in self._blocks) + int(
-            self.tree_.n_nodes[self.residual_layers_].sum() * self.n_features_in_
+            (n_residual + self.moments) * self.n_features_in_
         )
         return self
 
@@ -252,7 +302,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         routed = np.union1d(
             np.union1d(self.layers_, self.transition_layers_), self.residual_layers_
         )
-        nodes = self._router.route(frames, routed)
+        # moments alone need no routing
+        nodes = self._router.route(frames, routed) if len(routed) else None
         parts = []
         if self._blocks:
             parts.append(histogram_features(nodes, offsets, routed, self._blocks, self.power))
@@ -266,6 +317,25 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                     self.center_,
                     self.scale_,
                     self.power,
+                )
+            )
+        if self._residual_variances:
+            parts.append(
+                second_order_features(
+                    frames,
+                    nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                    offsets,
+                    self._residual_means,
+                    self._residual_variances,
+                    self.center_,
+                    self.scale_,
+                    self.power,
+                )
+            )
+        if self.moments:
+            parts.append(
+                moment_features(
+                    frames, offsets, self.moment_center_, self.moment_scale_, self.moments
                 )
             )
         if sparse:
@@ -293,7 +363,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         """Column names: each names its layer, node and pyramid cell (or step, or channel).
 
         ``layer<l>_node<k>_part<c>of<p>`` (occupancy), ``layer<l>_node<a>_to_node<b>``
-        (transitions), ``layer<l>_node<k>_<channel>`` (residuals).
+        (transitions), ``layer<l>_node<k>_<channel>`` (residuals),
+        ``layer<l>_node<k>_var_<channel>`` (their second order), ``mean_<channel>``
+        and ``rms_<channel>`` (moments).
 
         Parameters
         ----------
@@ -324,6 +396,14 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                 for k in range(self.tree_.n_nodes[layer])
                 for c in channels
             ]
+        for layer in self.residual_layers_ if self._residual_variances else ():
+            names += [
+                f"layer{layer}_node{k}_var_{c}"
+                for k in range(self.tree_.n_nodes[layer])
+                for c in channels
+            ]
+        for kind in ("mean", "rms")[: self.moments]:
+            names += [f"{kind}_{c}" for c in channels]
         return np.asarray(names, dtype=object)
 
 

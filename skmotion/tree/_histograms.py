@@ -9,7 +9,14 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["feature_blocks", "histogram_features", "residual_features"]
+__all__ = [
+    "feature_blocks",
+    "histogram_features",
+    "moment_features",
+    "node_variances",
+    "residual_features",
+    "second_order_features",
+]
 
 
 def feature_blocks(layers, n_nodes, pyramid, transition_layers):
@@ -134,6 +141,123 @@ def residual_features(frames, nodes, offsets, means, center, scale, power):
         share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
         block = ((average @ frames - share * center) / scale).reshape(n_clips, k, -1)
         block = (block - share.reshape(n_clips, k, 1) * mean).reshape(n_clips, -1)
+        if power != 1:
+            block = np.sign(block) * np.abs(block) ** power
+        norm = np.linalg.norm(block, axis=1, keepdims=True)
+        blocks.append(block / np.where(norm > 0, norm, 1.0))
+    return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))
+
+
+def moment_features(frames, offsets, center, scale, order):
+    """Per clip, the mean and root mean square of every channel in units of the training frames.
+
+    With ``z = (x - center) / scale`` (``center``, ``scale``: the training
+    frames' mean and standard deviation, the tree's root node), moment 1 is
+    ``mean_t z_t`` and moment 2 is ``sqrt(mean_t z_t ** 2) - 1``, per channel:
+    the root's first-order Fisher-vector term and the square root of its
+    second-order one (0 for a clip that spreads like the training frames; the
+    square root, like ``power`` elsewhere, tempers large values), not scaled
+    to unit norm, so a clip far from the training mean keeps its distance.
+    They say where a clip sits and how much it moves, the coarse description
+    the residuals of the nodes leave out (each of their blocks is scaled to
+    unit norm).
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, n_channels)
+        Raw frames.
+    offsets : ndarray of shape (n_clips + 1,)
+        Clip ``i`` is frames ``offsets[i]:offsets[i + 1]`` (none empty).
+    center, scale : ndarray of shape (n_channels,)
+    order : int
+        1 (means) or 2 (means, then root mean squares).
+
+    Returns
+    -------
+    features : ndarray of shape (n_clips, order * n_channels)
+    """
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(len(lengths)), lengths)
+    average = sp.csr_matrix(
+        (1.0 / lengths[clip], (clip, np.arange(len(frames)))), shape=(len(lengths), len(frames))
+    )
+    # one centred copy, squared in place, the scale applied to the sums: a pass over a batch's
+    # frames costs as much as the sums themselves
+    centred = np.subtract(frames, center)
+    blocks = [(average @ centred) / scale]
+    if order >= 2:
+        np.square(centred, out=centred)
+        blocks.append(np.sqrt(average @ centred) / scale - 1.0)
+    return np.hstack(blocks)
+
+
+def _node_averages(values, nodes, offsets, k):
+    """Per clip and node: the sums of ``values`` over the clip's frames in the node / its frames.
+
+    ``values`` is a list of arrays of shape (n_frames, n_channels), summed by one
+    sparse (clip, node) x frame matrix; also returns each group's share of its clip's frames.
+    """
+    n_clips, n_frames = len(offsets) - 1, len(nodes)
+    lengths = np.diff(offsets)
+    clip = np.repeat(np.arange(n_clips), lengths)
+    weight = 1.0 / lengths[clip]
+    group = clip * k + nodes
+    average = sp.csr_matrix((weight, (group, np.arange(n_frames))), shape=(n_clips * k, n_frames))
+    share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
+    return [average @ v for v in values], share
+
+
+def node_variances(z, nodes, means):
+    """Each node's per-channel variance of the standardised frames ``z`` routed to it.
+
+    1 where a node holds fewer than two frames; at least 1e-3 (a floor against
+    division by a node whose frames agree in a channel).
+    """
+    variances = []
+    for j, mean in enumerate(means):
+        node = nodes[:, j]
+        count = np.bincount(node, minlength=len(mean))[:, None]
+        squares = np.zeros_like(mean)
+        np.add.at(squares, node, (z - mean[node]) ** 2)
+        spread = np.maximum(squares / np.maximum(count, 1), 1e-3)
+        variances.append(np.where(count > 1, spread, 1.0))
+    return variances
+
+
+def second_order_features(frames, nodes, offsets, means, variances, center, scale, power):
+    """Per clip and node, the mean of ``(z - mean) ** 2 / variance - 1`` over its frames there.
+
+    A Fisher vector's variance terms over a layer's nodes (without their
+    constant factors), with ``z = (x - center) / scale``: how much more or less
+    the clip's frames spread within each node than the training frames did.
+    Each layer's block is raised to ``power`` with its sign and scaled to unit
+    norm, like the residuals.
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, n_channels)
+        Raw frames.
+    nodes, offsets, means, center, scale, power : as for :func:`residual_features`
+    variances : list of ndarray of shape (n_nodes(layer), n_channels)
+        From :func:`node_variances` on the training frames.
+
+    Returns
+    -------
+    features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
+    """
+    n_clips = len(offsets) - 1
+    # sum (z - m)^2 = sum z^2 - 2 m sum z + share m^2 per group: two sparse sums of one centred
+    # copy per layer, no per-frame gather of the node's mean (z and m are in standardised units,
+    # a few at most, so the expansion loses nothing that matters)
+    centred = np.subtract(frames, center)
+    squares = centred * centred
+    blocks = []
+    for j, (mean, variance) in enumerate(zip(means, variances)):
+        k = len(mean)
+        (first, second), share = _node_averages([centred, squares], nodes[:, j], offsets, k)
+        mean_rows, variance_rows = np.tile(mean, (n_clips, 1)), np.tile(variance, (n_clips, 1))
+        spread = second / scale**2 - 2 * mean_rows * first / scale + share * mean_rows**2
+        block = (spread / variance_rows - share).reshape(n_clips, -1)
         if power != 1:
             block = np.sign(block) * np.abs(block) ** power
         norm = np.linalg.norm(block, axis=1, keepdims=True)

@@ -59,10 +59,27 @@ def test_routing_matches_the_trees_splits_at_every_layer(split, rng):
     np.testing.assert_array_equal(some, routed[:, [2, 5]])
 
 
-def reference_features(encoder, clips):
+def reference_variances(encoder, train):
+    """Each residual node's per-channel variance of its training frames, by a loop over nodes."""
+    if encoder.residual_order == 1:
+        return []
+    z = (np.vstack(train) - encoder.center_) / encoder.scale_
+    variances = []
+    for layer in encoder.residual_layers_:
+        nodes = encoder.tree_.apply(z, layer)
+        variance = np.ones((encoder.tree_.n_nodes[layer], z.shape[1]))
+        for k in range(len(variance)):
+            if (nodes == k).sum() > 1:
+                variance[k] = np.maximum(z[nodes == k].var(axis=0), 1e-3)
+        variances.append(variance)
+    return variances
+
+
+def reference_features(encoder, clips, train=None):
     """The encoding by a loop over clips, frames and cells (an independent computation)."""
     rows = []
     tree = encoder.tree_
+    variances = reference_variances(encoder, clips if train is None else train)
     for clip in clips:
         z = (clip - encoder.center_) / encoder.scale_
         n = len(clip)
@@ -95,11 +112,29 @@ def reference_features(encoder, clips):
                 block[nodes[t]] += (z[t] - means[nodes[t]]) / n
             block = np.sign(block) * np.abs(block) ** encoder.power
             residuals.append(block.ravel() / np.linalg.norm(block))
-        rows.append(np.concatenate([hist, *residuals]))
+        for layer, variance in zip(encoder.residual_layers_, variances):
+            nodes = tree.apply(z, layer)
+            means = tree.means(layer)
+            block = np.zeros_like(means)
+            for t in range(n):
+                block[nodes[t]] += ((z[t] - means[nodes[t]]) ** 2 / variance[nodes[t]] - 1) / n
+            block = np.sign(block) * np.abs(block) ** encoder.power
+            residuals.append(block.ravel() / np.linalg.norm(block))
+        # moments: a loop over the clip's frames in units of the training frames
+        moments = []
+        if encoder.moments:
+            total, squares = np.zeros(clip.shape[1]), np.zeros(clip.shape[1])
+            for frame in clip:
+                u = (frame - encoder.moment_center_) / encoder.moment_scale_
+                total += u
+                squares += u * u
+            moments = [total / n, np.sqrt(squares / n) - 1][: encoder.moments]
+        rows.append(np.concatenate([hist, *residuals, *moments]))
     return np.array(rows)
 
 
-def test_features_match_a_per_clip_loop(motions):
+@pytest.mark.parametrize("moments, residual_order", [(0, 1), (1, 1), (2, 1), (2, 2)])
+def test_features_match_a_per_clip_loop(motions, moments, residual_order):
     X = motions[0][:12]
     X = X + [X[0][:2], X[1][:1]]  # clips shorter than the pyramid's cells
     encoder = MotionTreeEncoder(
@@ -108,10 +143,36 @@ def test_features_match_a_per_clip_loop(motions):
         pyramid=[1, 2, 3],
         transition_layers=[2],
         residual_layers=[1, 3],
+        residual_order=residual_order,
+        moments=moments,
         power=0.5,
         sparse_output=False,
     ).fit(X)
-    np.testing.assert_allclose(encoder.transform(X), reference_features(encoder, X), atol=1e-12)
+    features = encoder.transform(X)
+    np.testing.assert_allclose(features, reference_features(encoder, X), atol=1e-12)
+    names = encoder.get_feature_names_out()
+    assert len(names) == features.shape[1] == encoder.n_features_out_
+    last = {0: "layer3_node7_channel_59", 1: "mean_channel_59", 2: "rms_channel_59"}[moments]
+    assert names[-1] == last
+    if residual_order == 2:
+        assert "layer3_node7_var_channel_59" in names
+
+
+@pytest.mark.parametrize("standardize", [True, False])
+def test_moments_by_hand(standardize):
+    # Training frames 0, 2, 4, 6 and 1, 1, 1, 1: means 3 and 1, deviations sqrt(5) and 0 (taken
+    # as 1). The clip's first channel at 3 and 3 + sqrt(5) is at 0 and 1 in those units: mean
+    # 0.5, mean square 0.5, rms minus 1: sqrt(0.5) - 1; its second at 1 and 3 is at 0 and 2:
+    # mean 1, mean square 2, rms minus 1: sqrt(2) - 1.
+    train = [np.array([[0.0, 1.0], [2.0, 1.0]]), np.array([[4.0, 1.0], [6.0, 1.0]])]
+    encoder = MotionTreeEncoder(
+        residual_layers=(), moments=2, standardize=standardize, min_samples_leaf=1
+    ).fit(train, None)
+    clip = np.array([[3.0, 1.0], [3.0 + np.sqrt(5.0), 3.0]])
+    expected = [[0.5, 1.0, np.sqrt(0.5) - 1, np.sqrt(2.0) - 1]]
+    np.testing.assert_allclose(encoder.transform([clip]), expected, atol=1e-12)
+    names = encoder.get_feature_names_out(["a", "b"]).tolist()
+    assert names == ["mean_a", "mean_b", "rms_a", "rms_b"]
 
 
 def test_each_cell_is_a_distribution_and_names_follow_the_columns(motions):
@@ -168,9 +229,9 @@ def test_pipeline_recognises_held_out_subjects(motions):
 
 def test_pickled_encoder_gives_identical_features(motions):
     X = motions[0][:10]
-    encoder = MotionTreeEncoder().fit(X)
-    again = pickle.loads(pickle.dumps(encoder))
-    np.testing.assert_array_equal(encoder.transform(X), again.transform(X))
+    for encoder in (MotionTreeEncoder().fit(X), MotionTreeEncoder(residual_order=2).fit(X)):
+        again = pickle.loads(pickle.dumps(encoder))
+        np.testing.assert_array_equal(encoder.transform(X), again.transform(X))
     sparse = MotionTreeEncoder(layers="all", sparse_output=True).fit(X)
     assert (sparse.transform(X) != pickle.loads(pickle.dumps(sparse)).transform(X)).nnz == 0
 
@@ -184,6 +245,7 @@ def test_cells_partition_every_clip(lengths, parts):
         layers="all",
         pyramid=[parts],
         residual_layers=[],
+        moments=0,
         power=1.0,
         sparse_output=False,
     )
@@ -199,8 +261,9 @@ def test_cells_partition_every_clip(lengths, parts):
     [
         ({"pyramid": []}, "pyramid must name"),
         ({"pyramid": [0]}, "pyramid must hold ints >= 1"),
-        ({"layers": [9], "residual_layers": []}, "nothing to encode"),
-        ({"layers": [], "residual_layers": []}, "nothing to encode"),
+        ({"layers": [9], "residual_layers": [], "moments": 0}, "nothing to encode"),
+        ({"layers": [], "residual_layers": [], "moments": 0}, "nothing to encode"),
+        ({"moments": 3}, "moments"),
     ],
 )
 def test_bad_parameters_are_named(params, match, motions):
