@@ -29,16 +29,8 @@ import scipy.sparse as sp
 from sklearn.base import BaseEstimator, TransformerMixin
 
 from skmotion.tree import MotionTreeEncoder
+from skmotion.tree._histograms import _signed_power_unit_norm
 from skmotion.utils._clips import stack_clips
-
-
-def _signed_power(block, power):
-    return np.sign(block) * np.abs(block) ** power
-
-
-def _unit_rows(block):
-    norm = np.linalg.norm(block, axis=1, keepdims=True)
-    return block / np.where(norm > 0, norm, 1.0)
 
 
 def _clip_average(offsets, parts=1):
@@ -165,7 +157,7 @@ class TreeReadout(TransformerMixin, BaseEstimator):
                     terms.append(average @ second)
                 for term in terms:
                     term = term.reshape(len(offsets) - 1, -1)
-                    blocks.append(_unit_rows(_signed_power(term, 0.5)))
+                    blocks.append(_signed_power_unit_norm(term, 0.5))
         return blocks
 
     def _graph(self, frames, offsets):

@@ -25,7 +25,7 @@ import numpy as np
 
 from skmotion.preprocessing import _position_frame_loops as _loops
 
-__all__ = ["chain_size", "position_frame_features"]
+__all__ = ["position_frame_features"]
 
 #: Frames per call of the compiled loops (and per forward-kinematics block of
 #: VirtualMarkerTransform): large enough for the per-call overhead to vanish, small
@@ -33,30 +33,6 @@ __all__ = ["chain_size", "position_frame_features"]
 CHUNK = 4096
 # A body smaller than this fraction of its largest coordinate is lost in rounding.
 _TINY = 1e-10
-
-
-def chain_size(points, chain):
-    """Summed median distance between consecutive points of a chain (any dimension).
-
-    Parameters
-    ----------
-    points : ndarray of shape (n_frames, n_points, dim)
-    chain : sequence of int
-
-    Returns
-    -------
-    size : float
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from skmotion.preprocessing._position_frame import chain_size
-    >>> chain_size(np.array([[[0.0, 0.0], [3.0, 4.0], [3.0, 5.0]]]), [0, 1, 2])
-    6.0
-    """
-    chain = np.asarray(chain, dtype=np.intp)
-    steps = np.sqrt(((points[:, chain[1:]] - points[:, chain[:-1]]) ** 2).sum(axis=-1))
-    return float(np.median(steps, axis=0).sum())
 
 
 def _power_of_two_scale(peak):
@@ -109,7 +85,7 @@ def position_frame_features(
         Facing pairs: point ``lefts[k]`` is on the subject's left, ``rights[k]``
         on the right.
     size_chain : sequence of int, default=None
-        The body-size chain (:func:`chain_size`); None keeps the input unit.
+        The body-size chain (:func:`skmotion.kinematics.body_size`); None keeps the input unit.
     up : {"x", "y", "z", "-x", "-y", "-z"}, default="y"
         The vertical axis of the input (in 2-D, ``"y"`` or ``"-y"``).
     floor : "lowest" or float, default="lowest"

@@ -125,27 +125,25 @@ def residual_features(frames, nodes, offsets, means, center, scale, power):
     -------
     features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
     """
-    n_clips, n_frames = len(offsets) - 1, len(frames)
-    lengths = np.diff(offsets)
-    clip = np.repeat(np.arange(n_clips), lengths)
-    weight = 1.0 / lengths[clip]
+    n_clips = len(offsets) - 1
     blocks = []
     for j, mean in enumerate(means):
         k = len(mean)
-        group = clip * k + nodes[:, j]
-        # (clip, node) x frame averaging matrix: one sparse product sums every group of raw
-        # frames; sum (x - c) / s - mean = (sum x - share c) / s - share mean, share = sum 1 / n
-        average = sp.csr_matrix(
-            (weight, (group, np.arange(n_frames))), shape=(n_clips * k, n_frames)
-        )
-        share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
-        block = ((average @ frames - share * center) / scale).reshape(n_clips, k, -1)
+        # one sparse product sums every (clip, node) group of raw frames;
+        # sum (x - c) / s - mean = (sum x - share c) / s - share mean, share = sum 1 / n
+        (sums,), share = _node_averages([frames], nodes[:, j], offsets, k)
+        block = ((sums - share * center) / scale).reshape(n_clips, k, -1)
         block = (block - share.reshape(n_clips, k, 1) * mean).reshape(n_clips, -1)
-        if power != 1:
-            block = np.sign(block) * np.abs(block) ** power
-        norm = np.linalg.norm(block, axis=1, keepdims=True)
-        blocks.append(block / np.where(norm > 0, norm, 1.0))
+        blocks.append(_signed_power_unit_norm(block, power))
     return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))
+
+
+def _signed_power_unit_norm(block, power):
+    """``sign(b) |b| ** power`` per entry, then each row scaled to unit Euclidean norm."""
+    if power != 1:
+        block = np.sign(block) * np.abs(block) ** power
+    norm = np.linalg.norm(block, axis=1, keepdims=True)
+    return block / np.where(norm > 0, norm, 1.0)
 
 
 def moment_features(frames, offsets, center, scale, order):
@@ -258,8 +256,5 @@ def second_order_features(frames, nodes, offsets, means, variances, center, scal
         mean_rows, variance_rows = np.tile(mean, (n_clips, 1)), np.tile(variance, (n_clips, 1))
         spread = second / scale**2 - 2 * mean_rows * first / scale + share * mean_rows**2
         block = (spread / variance_rows - share).reshape(n_clips, -1)
-        if power != 1:
-            block = np.sign(block) * np.abs(block) ** power
-        norm = np.linalg.norm(block, axis=1, keepdims=True)
-        blocks.append(block / np.where(norm > 0, norm, 1.0))
+        blocks.append(_signed_power_unit_norm(block, power))
     return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))

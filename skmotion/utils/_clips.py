@@ -94,6 +94,10 @@ def _describe_bad_value(clip, clip_index, input_name):
 
 def _as_float_clip(clip, clip_index, dtype, input_name):
     """Convert one clip to a numeric array, naming the clip when it cannot be."""
+    if type(clip) is np.ndarray and clip.dtype in dtype:
+        # already an accepted float array: none of the checks below applies (a query
+        # batch is many small clips, where they would cost more than the clip's own work)
+        return clip, clip.dtype
     if sp.issparse(clip):
         raise TypeError(
             f"{input_name}: clip {clip_index} is a sparse matrix; clips must be "
@@ -210,12 +214,7 @@ def _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name)
     clips = []
     n_channels = None
     for i, clip in enumerate(raw):
-        # Fast path (queries arrive as many small clips): a float array already in
-        # an accepted dtype needs none of the conversions below.
-        if type(clip) is np.ndarray and clip.dtype in dtypes:
-            arr, target = clip, clip.dtype
-        else:
-            arr, target = _as_float_clip(clip, i, dtypes, input_name)
+        arr, target = _as_float_clip(clip, i, dtypes, input_name)
         if arr.ndim != 2:
             raise ValueError(
                 f"{input_name}: clip {i} is {arr.ndim}-D with shape {arr.shape}; "

@@ -3,8 +3,9 @@
 import numpy as np
 import pytest
 
+from skmotion.kinematics import body_size
 from skmotion.preprocessing import VirtualMarkerTransform, get_layout
-from skmotion.preprocessing._position_frame import chain_size, position_frame_features
+from skmotion.preprocessing._position_frame import position_frame_features
 
 UNIT = {"x": [1.0, 0, 0], "y": [0, 1.0, 0], "z": [0, 0, 1.0]}
 
@@ -13,7 +14,7 @@ def _reference_3d(points, root, lefts, rights, chain, up, floor, rate, outputs):
     """Frame by frame from the definition: left = horizontal part of the summed left-minus-
     right vectors, forward = left x up, origin on the floor below the mean of the root."""
     u = np.array(UNIT[up[-1]]) * (-1.0 if up.startswith("-") else 1.0)
-    size = chain_size(points, chain)
+    size = body_size(points, chain)
     level = np.min(points @ u) if floor == "lowest" else floor * u.sum()
     velocity = np.gradient(points, axis=0) * rate
     rows = []
@@ -33,7 +34,7 @@ def _reference_3d(points, root, lefts, rights, chain, up, floor, rate, outputs):
 def _reference_2d(points, root, lefts, rights, chain, up, floor, rate, outputs):
     """Image plane: horizontal offset from the root, signed so the median left-minus-right
     offset is positive; height above the lowest point (rows grow down when up='-y')."""
-    size = chain_size(points, chain)
+    size = body_size(points, chain)
     lateral = sum(points[:, a, 0] - points[:, b, 0] for a, b in zip(lefts, rights))
     sign = -1.0 if np.median(lateral) < 0 else 1.0
     height = points[..., 1] * (-1.0 if up == "-y" else 1.0)
