@@ -6,7 +6,7 @@ import numpy as np
 from sklearn.utils import Bunch, check_random_state
 
 from skmotion.datasets._humanoid import humanoid_skeleton
-from skmotion.datasets._synthetic import _TWO_PI, _WALK, _bump, _gait, _Pose
+from skmotion.datasets._motion_generators import _TWO_PI, _WALK, _bump, _gait, _Pose
 from skmotion.kinematics import forward_kinematics
 from skmotion.utils._sklearn_compat import Interval, validate_params
 
