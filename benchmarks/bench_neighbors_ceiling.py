@@ -17,6 +17,10 @@ above what any fixed widths reach with that distance. ``one_miss`` is the
 smallest recall one lost similar clip costs: where it is above 0.01, a
 recall of 0.99 means keeping every similar clip, and the ceiling at 0.99 is
 the exact one at recall 1.
+
+``--segmentations N``: psi's ceiling on the CMU joint angles for N random
+cuts of the trials into segments (``cut_repeats(random_state=0 .. N-1)``;
+the development set is cut 0), to show it is not one cut's accident.
 """
 
 import sys
@@ -25,9 +29,11 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from _common import write_results  # noqa: E402
-from bench_neighbors_pruning import held_out_sets  # noqa: E402
+from _common import SHARED_DATA, write_results  # noqa: E402
+from _motion_data import _ROOT_CHANNELS, cut_repeats  # noqa: E402
+from bench_neighbors_pruning import held_out_sets, hold_out_last  # noqa: E402
 
+from skmotion.datasets import load_cmu_asfamc  # noqa: E402
 from skmotion.decomposition import SVDFeatureExtractor  # noqa: E402
 from skmotion.decomposition._svd_projection import max_svd_components  # noqa: E402
 from skmotion.metrics import pruning_ceiling, pruning_efficiency, recall  # noqa: E402
@@ -103,5 +109,31 @@ def main():
     return rows
 
 
+def segmentations(n):
+    """psi's ceiling on the CMU repetitions (joint angles) for ``n`` random cuts."""
+    data = load_cmu_asfamc(SHARED_DATA / "cmu-asfamc", index=SHARED_DATA / "cmu-index.csv")
+    angles = [clip[:, _ROOT_CHANNELS:] for clip in data.clips]
+    rows = []
+    for seed in range(n):
+        segments, trial = cut_repeats(angles, data.frame_rate, random_state=seed)
+        train, y_train, query, y_query = hold_out_last(segments, np.asarray(data.trials)[trial])
+        dist = 1.0 - pairwise_psi(query, train)
+        row = {"cut": seed, "stored": len(train), "queries": len(query)}
+        for r in RECALLS:
+            row[f"psi@{r}"] = pruning_ceiling(dist, y_query, y_train, min_recall=r)
+        rows.append(row)
+    write_results(
+        "neighbors_ceiling_cuts",
+        rows,
+        notes="CMU 01-03 trials (joint angles without the root) cut into 5 consecutive "
+        "segments of 1-2 s by cut_repeats(random_state=cut); the last segment of each trial "
+        "queries the rest. psi@r: pruning_ceiling of 1 - psi at mean recall r.",
+    )
+    return rows
+
+
 if __name__ == "__main__":
-    main()
+    if "--segmentations" in sys.argv:
+        segmentations(int(sys.argv[sys.argv.index("--segmentations") + 1]))
+    else:
+        main()

@@ -96,16 +96,24 @@ def held_out_sets():
             test = load_uea(name, subset="test", data_home=SHARED_DATA)
             sets[name] = (train.clips, train.target, test.clips, test.target)
             continue
-        labels = np.asarray(labels)
-        last = np.zeros(len(labels), bool)
-        for g in np.unique(labels):
-            at = np.flatnonzero(labels == g)
-            if len(at) > 1:
-                last[at[-1]] = True
-        train = [c for c, q in zip(clips, last) if not q]
-        query = [c for c, q in zip(clips, last) if q]
-        sets[name] = (train, labels[~last], query, labels[last])
+        sets[name] = hold_out_last(clips, labels)
     return sets
+
+
+def hold_out_last(clips, labels):
+    """(train clips, train labels, query clips, query labels): each label's last clip queries.
+
+    A label with one clip stays stored (it has nothing similar to find).
+    """
+    labels = np.asarray(labels)
+    last = np.zeros(len(labels), bool)
+    for g in np.unique(labels):
+        at = np.flatnonzero(labels == g)
+        if len(at) > 1:
+            last[at[-1]] = True
+    train = [c for c, q in zip(clips, last) if not q]
+    query = [c for c, q in zip(clips, last) if q]
+    return train, labels[~last], query, labels[last]
 
 
 RULES = (
