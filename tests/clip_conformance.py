@@ -3,10 +3,9 @@
 This module re-exports them for the project's tests written against the old place.
 """
 
+from skmotion.utils._conformance_helpers import _as_list, _fit  # noqa: F401
 from skmotion.utils.estimator_checks import *  # noqa: F403
 from skmotion.utils.estimator_checks import (  # noqa: F401
-    _as_list,
-    _fit,
     as_dataframe,
     assert_outputs_equal,
     check_channel_mismatch,

@@ -8,6 +8,13 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
+from skmotion.tree._encoder_columns import (
+    _existing,
+    _int_list,
+    _is_all,
+    build_depth,
+    feature_names,
+)
 from skmotion.tree._histograms import (
     feature_blocks,
     histogram_features,
@@ -239,7 +246,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         say(self.verbose, f"MotionTreeEncoder: building the tree over {len(frames):,} frames")
         self.tree_ = MotionTree.build(
             (frames - self.center_) / self.scale_,
-            max_depth=self._build_depth(),
+            max_depth=build_depth(
+                self.max_depth, self.layers, self.transition_layers, self.residual_layers
+            ),
             min_samples_leaf=self.min_samples_leaf,
             split=self.split,
             covariance_type="spherical",  # routing uses the splits only
@@ -343,17 +352,6 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         dense = [p.toarray() if sp.issparse(p) else p for p in parts]
         return self._wrap_table(dense[0] if len(dense) == 1 else np.hstack(dense), clips)
 
-    def _build_depth(self):
-        """The deepest layer any block reads (a deeper tree would be built for nothing)."""
-        if _is_all(self.layers):
-            return self.max_depth
-        wanted = [
-            *_int_list("layers", self.layers),
-            *_int_list("transition_layers", self.transition_layers),
-            *_int_list("residual_layers", self.residual_layers),
-        ]
-        return min(self.max_depth, max(wanted, default=1))
-
     def _sparse(self):
         if self.sparse_output == "auto":
             return sum(width for *_, width in self._blocks) >= _SPARSE_FROM
@@ -377,47 +375,11 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         feature_names_out : ndarray of str
         """
         check_is_fitted(self)
-        names = []
-        for kind, layer, parts, width in self._blocks:
-            if kind == "occupancy":
-                k = width // parts
-                names += [
-                    f"layer{layer}_node{n}_part{c + 1}of{parts}"
-                    for c in range(parts)
-                    for n in range(k)
-                ]
-            else:
-                k = int(round(np.sqrt(width)))
-                names += [f"layer{layer}_node{a}_to_node{b}" for a in range(k) for b in range(k)]
-        channels = channel_names_in(self, input_features)
-        for layer in self.residual_layers_:
-            names += [
-                f"layer{layer}_node{k}_{c}"
-                for k in range(self.tree_.n_nodes[layer])
-                for c in channels
-            ]
-        for layer in self.residual_layers_ if self._residual_variances else ():
-            names += [
-                f"layer{layer}_node{k}_var_{c}"
-                for k in range(self.tree_.n_nodes[layer])
-                for c in channels
-            ]
-        for kind in ("mean", "rms")[: self.moments]:
-            names += [f"{kind}_{c}" for c in channels]
-        return np.asarray(names, dtype=object)
-
-
-def _is_all(value):
-    return isinstance(value, str) and value == "all"
-
-
-def _existing(name, values, bottom):
-    """The layers of ``values`` that the tree has, sorted, without repeats."""
-    return np.array(sorted({v for v in _int_list(name, values) if v <= bottom}), dtype=np.intp)
-
-
-def _int_list(name, values, low=0):
-    values = np.asarray(values).ravel()
-    if values.size and (values.dtype.kind not in "iu" or values.min() < low):
-        raise ValueError(f"{name} must hold ints >= {low}; got {values.tolist()!r}.")
-    return [int(v) for v in values]
+        return feature_names(
+            self._blocks,
+            self.residual_layers_,
+            self.tree_.n_nodes,
+            channel_names_in(self, input_features),
+            second_order=bool(self._residual_variances),
+            moments=self.moments,
+        )

@@ -5,6 +5,9 @@ collection is given as a list (or tuple) of such arrays, a 3-D array of
 equal-length clips, or a pandas DataFrame with a two-level ``(clip, frame)``
 MultiIndex. :func:`check_clips` is the only place where collections are checked
 and converted; :func:`to_container` returns results in the caller's kind.
+
+The per-clip conversion and checks are in ``_clip_checks``, the DataFrame
+splitting and building in ``_clip_dataframes``.
 """
 
 from dataclasses import dataclass
@@ -13,6 +16,13 @@ from numbers import Integral
 import numpy as np
 import pandas as pd
 import scipy.sparse as sp
+
+from skmotion.utils._clip_checks import _check_each_clip, _estimator_name, _normalise_dtypes
+from skmotion.utils._clip_dataframes import (
+    _check_feature_names,
+    clips_to_dataframe,
+    split_dataframe,
+)
 
 __all__ = [
     "Clips",
@@ -68,191 +78,6 @@ class Clips(list):
     def lengths(self):
         """Number of frames of each clip, as an int array."""
         return np.fromiter((len(c) for c in self), dtype=np.intp, count=len(self))
-
-
-def _label(value):
-    """repr of an index label, without numpy's scalar wrapper."""
-    return repr(value.item() if isinstance(value, np.generic) else value)
-
-
-def _estimator_name(estimator):
-    return type(estimator).__name__ if estimator is not None else "this function"
-
-
-def _describe_bad_value(clip, clip_index, input_name):
-    """Name the first NaN/inf in a clip: clip, frame and channel."""
-    bad = ~np.isfinite(clip)
-    frame, channel = np.argwhere(bad)[0]
-    value = clip[frame, channel]
-    what = "NaN" if np.isnan(value) else ("inf" if value > 0 else "-inf")
-    n_bad = int(bad.sum())
-    more = f" ({n_bad} non-finite values in this clip)" if n_bad > 1 else ""
-    return (
-        f"{input_name}: clip {clip_index} contains {what} at frame {frame}, channel {channel}{more}"
-    )
-
-
-def _as_float_clip(clip, clip_index, dtype, input_name):
-    """Convert one clip to a numeric array, naming the clip when it cannot be."""
-    if type(clip) is np.ndarray and clip.dtype in dtype:
-        # already an accepted float array: none of the checks below applies (a query
-        # batch is many small clips, where they would cost more than the clip's own work)
-        return clip, clip.dtype
-    if sp.issparse(clip):
-        raise TypeError(
-            f"{input_name}: clip {clip_index} is a sparse matrix; clips must be "
-            "dense 2-D arrays of shape (n_frames, n_channels)."
-        )
-    if isinstance(clip, pd.DataFrame):
-        clip = clip.to_numpy()
-    arr = np.asarray(clip)
-    if arr.dtype.kind == "c":
-        raise ValueError(f"{input_name}: clip {clip_index} has complex values; clips must be real.")
-    if arr.dtype.kind not in "biuf":
-        try:
-            arr = arr.astype(np.float64)
-        except (TypeError, ValueError) as exc:
-            raise ValueError(
-                f"{input_name}: clip {clip_index} has non-numeric data (dtype {arr.dtype}): {exc}"
-            ) from None
-    target = arr.dtype if arr.dtype in dtype else dtype[0]
-    return arr, target
-
-
-def _normalise_dtypes(dtype):
-    if isinstance(dtype, (list, tuple)):
-        return tuple(np.dtype(d) for d in dtype)
-    return (np.dtype(dtype),)
-
-
-def _collection_from_dataframe(X, input_name):
-    """Split a (clip, frame) MultiIndex DataFrame into per-clip arrays."""
-    index = X.index
-    if not isinstance(index, pd.MultiIndex) or index.nlevels != 2:
-        raise ValueError(
-            f"{input_name} is a DataFrame without a two-level (clip, frame) "
-            "MultiIndex; got index "
-            f"{type(index).__name__} with {index.nlevels} level(s). Build one with "
-            "pd.concat({clip_id: frame_table, ...}) or df.set_index(['clip', 'frame'])."
-        )
-    if len(X) == 0:
-        raise ValueError(f"{input_name} is an empty collection: it holds no clips.")
-    codes, labels = pd.factorize(index.get_level_values(0), sort=False)
-    for level, what in ((codes, "clip"), (index.codes[1], "frame")):
-        if (level < 0).any():  # pandas codes a missing label (NaN, None) as -1
-            row = int(np.flatnonzero(level < 0)[0])
-            raise ValueError(
-                f"{input_name}: row {row} of the DataFrame has a missing {what} label (NaN) in "
-                "its (clip, frame) index; every row needs a clip and a frame label."
-            )
-    starts = np.flatnonzero(np.r_[True, codes[1:] != codes[:-1]])
-    if len(starts) != len(labels):
-        repeated = labels[np.bincount(codes[starts]).argmax()]
-        raise ValueError(
-            f"{input_name}: the rows of clip {_label(repeated)} are not contiguous in the "
-            "DataFrame; sort it by clip first (df.sort_index(level=0, sort_remaining=False))."
-        )
-    frames = index.get_level_values(1)
-    if len(frames) > 1:
-        frame_values = np.asarray(frames)
-        try:
-            step_ok = frame_values[1:] > frame_values[:-1]
-        except TypeError:
-            raise ValueError(
-                f"{input_name}: the frame level of the index is not orderable "
-                f"(dtype {frames.dtype})."
-            ) from None
-        step_ok[starts[1:] - 1] = True
-        if not step_ok.all():
-            row = int(np.flatnonzero(~step_ok)[0]) + 1
-            clip_label = labels[codes[row]]
-            raise ValueError(
-                f"{input_name}: frames of clip {_label(clip_label)} are not strictly "
-                f"increasing (at frame label {_label(frame_values[row])}); sort the index."
-            )
-    values = X.to_numpy()
-    clips = np.split(values, starts[1:])
-    container = Container(
-        kind="dataframe",
-        clip_labels=pd.Index(labels),
-        index_names=tuple(index.names),
-        columns=X.columns,
-    )
-    return clips, container
-
-
-def _feature_names(X):
-    """Channel names of a DataFrame whose columns are all strings, else None."""
-    if isinstance(X, pd.DataFrame):
-        columns = np.asarray(X.columns, dtype=object)
-        if len(columns) and all(isinstance(c, str) for c in columns):
-            return columns
-    return None
-
-
-def _check_feature_names(X, estimator, reset, input_name):
-    names = _feature_names(X)
-    if reset:
-        if names is not None:
-            estimator.feature_names_in_ = names
-        elif hasattr(estimator, "feature_names_in_"):
-            del estimator.feature_names_in_
-        return
-    fitted = getattr(estimator, "feature_names_in_", None)
-    if fitted is None or names is None:
-        return
-    if len(fitted) == len(names) and np.array_equal(fitted, names):
-        return
-    raise ValueError(
-        f"{input_name}: channel names differ from those seen in fit by "
-        f"{_estimator_name(estimator)}: expected {list(fitted)}, got {list(names)}."
-    )
-
-
-def _check_each_clip(raw, dtypes, min_frames, allow_nan, copy, name, input_name):
-    """The clips as C-contiguous float arrays, checked one by one; and their channel count."""
-    clips = []
-    n_channels = None
-    for i, clip in enumerate(raw):
-        arr, target = _as_float_clip(clip, i, dtypes, input_name)
-        if arr.ndim != 2:
-            raise ValueError(
-                f"{input_name}: clip {i} is {arr.ndim}-D with shape {arr.shape}; "
-                "expected a 2-D array of shape (n_frames, n_channels)"
-                + (" (use clip.reshape(-1, 1) for one channel)." if arr.ndim == 1 else ".")
-            )
-        if arr.shape[0] == 0 and min_frames > 0:
-            raise ValueError(f"{input_name}: clip {i} has no frames.")
-        if arr.shape[1] == 0:
-            raise ValueError(f"{input_name}: clip {i} has no channels.")
-        if arr.shape[0] < min_frames:
-            raise ValueError(
-                f"{input_name}: clip {i} has {arr.shape[0]} frame(s); {name} needs "
-                f"at least {min_frames}."
-            )
-        if n_channels is None:
-            n_channels = arr.shape[1]
-        elif arr.shape[1] != n_channels:
-            raise ValueError(
-                f"{input_name}: clip {i} has {arr.shape[1]} channels, but clip 0 has "
-                f"{n_channels}; all clips of a collection share their channels."
-            )
-        arr = np.array(arr, dtype=target, order="C", copy=copy or None)
-        # A finite sum means every value is finite (one pass, no temporary array);
-        # a non-finite one may be an overflow of finite values, so look closer.
-        if not np.isfinite(np.add.reduce(arr, axis=None)):
-            if allow_nan:
-                if np.isinf(arr).any():
-                    raise ValueError(
-                        _describe_bad_value(np.where(np.isnan(arr), 0, arr), i, input_name)
-                    )
-            elif not np.isfinite(arr).all():
-                raise ValueError(
-                    _describe_bad_value(arr, i, input_name)
-                    + f"; {name} does not accept missing values (fill gaps first)."
-                )
-        clips.append(arr)
-    return clips, n_channels
 
 
 def check_clips(
@@ -331,7 +156,10 @@ def check_clips(
         min_frames = tags().min_frames if tags is not None else 1
     feature_source = X
     if isinstance(X, pd.DataFrame):
-        raw, container = _collection_from_dataframe(X, input_name)
+        raw, labels, index_names, columns = split_dataframe(X, input_name)
+        container = Container(
+            kind="dataframe", clip_labels=labels, index_names=index_names, columns=columns
+        )
     elif isinstance(X, np.ndarray) or sp.issparse(X):
         if sp.issparse(X):
             raise TypeError(
@@ -382,10 +210,6 @@ def check_clips(
     return Clips(clips, container)
 
 
-def _check_index_name(value, default):
-    return value if value is not None else default
-
-
 def to_container(clips, container, *, columns=None):
     """Return clips in the kind of collection the caller gave.
 
@@ -431,26 +255,7 @@ def to_container(clips, container, *, columns=None):
         raise ValueError(
             f"Unknown container kind {kind!r}; expected one of {sorted(CONTAINER_KINDS)}."
         )
-    n_channels = clips[0].shape[1] if len(clips) else 0
-    if columns is None:
-        if container.columns is not None and len(container.columns) == n_channels:
-            columns = container.columns
-        else:
-            columns = [f"channel_{j}" for j in range(n_channels)]
-    labels = container.clip_labels
-    if labels is None or len(labels) != len(clips):
-        labels = pd.RangeIndex(len(clips))
-    names = container.index_names or ("clip", "frame")
-    lengths = [len(c) for c in clips]
-    index = pd.MultiIndex.from_arrays(
-        [
-            np.repeat(np.asarray(labels, dtype=object), lengths),
-            np.concatenate([np.arange(n) for n in lengths]),
-        ],
-        names=[_check_index_name(names[0], "clip"), _check_index_name(names[1], "frame")],
-    )
-    values = np.concatenate(clips) if clips else np.empty((0, n_channels))
-    return pd.DataFrame(values, index=index, columns=pd.Index(columns))
+    return clips_to_dataframe(clips, container, columns)
 
 
 def stack_clips(clips):
