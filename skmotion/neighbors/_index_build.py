@@ -1,17 +1,19 @@
-"""How IntervalIndexNeighbors builds its tree: entry widths, insertion, stored clips.
+"""How IntervalIndexNeighbors builds its tree and grows it: entry widths, insertion.
 
 A mixin of :class:`~skmotion.neighbors.IntervalIndexNeighbors` (the class stays
 in ``_interval_neighbors``, where pickles look for it): learning ``delta_`` and
-the radii, building the :class:`IntervalIndex`, and the arrays kept per stored clip.
+the radii, building the :class:`IntervalIndex`; ``insert`` and ``partial_fit``.
 """
 
 import numpy as np
 from sklearn.utils import check_random_state
+from sklearn.utils.validation import check_is_fitted
 
 from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
 from skmotion.neighbors._store import GrowableStore
 from skmotion.neighbors._widths import learn_delta, radius_for_recall
 from skmotion.utils._progress import say
+from skmotion.utils._sklearn_compat import _fit_context
 
 __all__ = []
 
@@ -20,7 +22,7 @@ _DEFAULT_RECALL = 0.99
 
 
 class _IndexBuildMixin:
-    """Fitting the tree's layout and storing the clips' features, signatures and labels."""
+    """Fitting the tree's layout (``_fit``, behind ``fit``), and ``insert``, ``partial_fit``."""
 
     def _fit(self, X, y, classes=None):
         say(self.verbose, f"{type(self).__name__}: decomposing the clips")
@@ -81,3 +83,55 @@ class _IndexBuildMixin:
             n_jobs=self.n_jobs,
         )
         return radius
+
+    def insert(self, X, y):
+        """Add clips to the fitted index, without rebuilding it.
+
+        The feature projection, ``delta_`` and the entries stay as fitted.
+
+        Parameters
+        ----------
+        X : clips or feature vectors, as given to :meth:`fit`
+            The clips to add; they get ids ``n_samples_fit_, n_samples_fit_ + 1, ...``.
+        y : array-like of shape (n_clips,)
+            Their labels, from ``classes_``.
+
+        Returns
+        -------
+        self : IntervalIndexNeighbors
+            The index, now holding the new clips.
+        """
+        check_is_fitted(self)
+        tree_features, ranking = self._describe(X, reset=False)
+        y = self._check_labels(y, len(tree_features), known=True)
+        self._check_known(y)
+        encoded = np.searchsorted(self.classes_, y)
+        self.index_.insert(tree_features)
+        self._store(tree_features, ranking, encoded)
+        return self
+
+    def partial_fit(self, X, y, classes=None):
+        """Fit on the first call, then :meth:`insert`.
+
+        Parameters
+        ----------
+        X : clips or feature vectors
+            Clips to index.
+        y : array-like of shape (n_clips,)
+            Their labels.
+        classes : array-like of shape (n_classes,), default=None
+            All the labels later calls may bring; used on the first call only
+            (by default the labels of that call).
+
+        Returns
+        -------
+        self : IntervalIndexNeighbors
+            The index.
+        """
+        if not hasattr(self, "index_"):
+            return self._fit_first(X, y, classes)
+        return self.insert(X, y)
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def _fit_first(self, X, y, classes):
+        return self._fit(X, y, classes)

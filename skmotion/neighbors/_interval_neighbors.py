@@ -9,7 +9,6 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
-from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.decomposition import SVDFeatureExtractor
@@ -267,58 +266,6 @@ class IntervalIndexNeighbors(
             The fitted index.
         """
         return self._fit(X, y)
-
-    def insert(self, X, y):
-        """Add clips to the fitted index, without rebuilding it.
-
-        The feature projection, ``delta_`` and the entries stay as fitted.
-
-        Parameters
-        ----------
-        X : clips or feature vectors, as given to :meth:`fit`
-            The clips to add; they get ids ``n_samples_fit_, n_samples_fit_ + 1, ...``.
-        y : array-like of shape (n_clips,)
-            Their labels, from ``classes_``.
-
-        Returns
-        -------
-        self : IntervalIndexNeighbors
-            The index, now holding the new clips.
-        """
-        check_is_fitted(self)
-        tree_features, ranking = self._describe(X, reset=False)
-        y = self._check_labels(y, len(tree_features), known=True)
-        self._check_known(y)
-        encoded = np.searchsorted(self.classes_, y)
-        self.index_.insert(tree_features)
-        self._store(tree_features, ranking, encoded)
-        return self
-
-    def partial_fit(self, X, y, classes=None):
-        """Fit on the first call, then :meth:`insert`.
-
-        Parameters
-        ----------
-        X : clips or feature vectors
-            Clips to index.
-        y : array-like of shape (n_clips,)
-            Their labels.
-        classes : array-like of shape (n_classes,), default=None
-            All the labels later calls may bring; used on the first call only
-            (by default the labels of that call).
-
-        Returns
-        -------
-        self : IntervalIndexNeighbors
-            The index.
-        """
-        if not hasattr(self, "index_"):
-            return self._fit_first(X, y, classes)
-        return self.insert(X, y)
-
-    @_fit_context(prefer_skip_nested_validation=True)
-    def _fit_first(self, X, y, classes):
-        return self._fit(X, y, classes)
 
     # -- queries -------------------------------------------------------------------
 
