@@ -12,7 +12,8 @@
   slow; its linear cost is extrapolated to the largest collection).
 
 First, the cost of one query of a 40-frame, 60-channel clip (features,
-traversal, end to end; CPU time, batched). Run:
+traversal, end to end; CPU time, batched, and for ``candidates`` and
+``kneighbors`` also one clip per call: the difference is the per-call cost). Run:
 ``python benchmarks/bench_neighbors_query.py`` (``--quick``: that table only).
 """
 
@@ -50,6 +51,8 @@ def fast_signatures(clips, k):
 
 
 N_QUERIES = 500
+# Queries timed one call each (the per-call cost of validation, set-up and dispatch).
+N_SINGLE = 200
 PARAMS = {"n_levels": 7, "target_recall": 0.99, "random_state": 0}
 
 
@@ -277,7 +280,15 @@ def query_cost_rows(n_stored=10_000, n_queries=1_000):
         ),
         ("traversal, batched", lambda: index.index_.leaf_of(tree)),
         ("candidates: validation + features + traversal", lambda: index.candidates(queries)),
+        (
+            "candidates, one clip per call (index.candidates([clip]))",
+            lambda: [index.candidates([clip]) for clip in queries[:N_SINGLE]],
+        ),
         ("end to end 1-NN: IntervalIndexNeighbors.kneighbors", lambda: index.kneighbors(queries)),
+        (
+            "end to end 1-NN, one clip per call (index.kneighbors([clip]))",
+            lambda: [index.kneighbors([clip]) for clip in queries[:N_SINGLE]],
+        ),
         ("end to end 1-NN: brute-force psi", brute_psi),
         (
             "end to end 1-NN: brute force on the index's features",
@@ -291,7 +302,9 @@ def query_cost_rows(n_stored=10_000, n_queries=1_000):
                 "stored": n_stored,
                 "clip": "40 x 60",
                 "what": what,
-                "cpu_us_per_query": _cpu_us(func, n_queries),
+                "cpu_us_per_query": _cpu_us(
+                    func, N_SINGLE if "one clip per call" in what else n_queries
+                ),
                 "agrees_with_psi_brute_force": float(np.mean(found == reference))
                 if "IntervalIndex" in what
                 else float("nan"),

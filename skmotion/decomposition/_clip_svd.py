@@ -9,6 +9,8 @@ whose matrices have one size are decomposed in one batched call. Nothing loops
 over frames.
 """
 
+from contextlib import nullcontext
+
 import numpy as np
 
 # threadpoolctl comes with scikit-learn (one of its own dependencies).
@@ -27,13 +29,19 @@ def small_blas():
     far longer synchronising its threads than computing, and on a busy machine
     it slows them a hundredfold. Parallelism comes from ``n_jobs`` instead.
     """
-    global _CONTROLLER
+    global _CONTROLLER, _BLAS
     if _CONTROLLER is None:  # finding the loaded BLAS libraries is slow: do it once
         _CONTROLLER = ThreadpoolController()
+        _BLAS = _CONTROLLER.select(user_api="blas").lib_controllers
+    if all(blas.num_threads == 1 for blas in _BLAS):
+        # Already one thread (OMP_NUM_THREADS=1, a joblib worker): nothing to limit, and
+        # setting and restoring the limits costs as much as a one-clip query's pairs.
+        return nullcontext()
     return _CONTROLLER.limit(limits=1, user_api="blas")
 
 
 _CONTROLLER = None
+_BLAS = []
 
 # Clips per task: fixed, so the tasks (and so the results) do not depend on n_jobs.
 _CHUNK = 512

@@ -390,6 +390,28 @@ cdef int _one_clip(const double* clip, int n_frames, int n_channels, int n_vecto
     return info
 
 
+# The normal draws the start blocks are cut from (grown on demand): drawing a
+# block afresh cost about as much as the pairs of a 40 x 60 clip.
+_DRAWS = np.zeros(0)
+
+
+def _start_block(int n_max, int block):
+    """The fixed start block of subspace iteration (reproducible answers).
+
+    ``default_rng(0).standard_normal((n_max, block))``: the generator fills an
+    array draw after draw, so that block is the first ``n_max * block`` draws
+    of any longer call, reshaped (read-only, shared between calls).
+    """
+    global _DRAWS
+    cdef Py_ssize_t size = n_max * block
+    draws = _DRAWS  # one read: another thread may swap in a longer array meanwhile
+    if len(draws) < size:
+        draws = np.random.default_rng(0).standard_normal(max(size, 2 * len(draws)))
+        draws.setflags(write=False)
+        _DRAWS = draws
+    return draws[:size].reshape(n_max, block)
+
+
 def leading_spectra(list clips, int n_vectors, double tolerance, int check, int max_steps):
     """Leading eigenvalues and right singular vectors of each clip (unit-scaled).
 
@@ -428,8 +450,7 @@ def leading_spectra(list clips, int n_vectors, double tolerance, int check, int 
         longest = max(longest, frames[c])
     n_max = max(1, min(longest, n_channels))
     block = min(n_max, n_vectors + 4)
-    # The fixed start block of subspace iteration (reproducible answers).
-    start = np.random.default_rng(0).standard_normal((n_max, block))
+    start = _start_block(n_max, block)
     failed = _run(clips, &frames[0], n_channels, n_vectors, &values[0, 0], &vectors[0, 0, 0],
                   longest, n_max, block, start, tolerance, check, max_steps)
     if failed >= 0:

@@ -321,6 +321,8 @@ class IntervalIndex:
         what is left per leaf is a slice (or, after insertions, a concatenation
         of one slice per block, oldest block first: ids increase).
         """
+        if len(leaves) == 1:  # one query: a search per block costs less than the bounds
+            return [self.leaf_items(leaves[0]).astype(np.intp)]
         blocks, bounds = self._leaf_bounds(leaves)
         bounds = [(start.tolist(), end.tolist()) for start, end in bounds]
         if len(blocks) == 1:

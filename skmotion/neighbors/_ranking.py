@@ -97,7 +97,8 @@ def nearest_in_leaves(leaves, rank_leaf, n_neighbors, *, leaves_per_task=32, n_j
     distances, indices : ndarray of shape (n_queries, n_neighbors)
     """
     order = np.argsort(leaves, kind="stable")
-    bounds = np.flatnonzero(np.r_[True, leaves[order][1:] != leaves[order][:-1], True])
+    ordered = leaves[order]
+    bounds = np.flatnonzero(np.concatenate(([True], ordered[1:] != ordered[:-1], [True])))
     groups = [(leaves[order[a]], order[a:b]) for a, b in zip(bounds[:-1], bounds[1:])]
     step = leaves_per_task
     tasks = [groups[i : i + step] for i in range(0, len(groups), step)]

@@ -90,3 +90,24 @@ def test_iterative_leading_pairs_match_the_full_svd(seed, shape, n_vectors):
             if gaps.min() < 1e-3 * s[0] ** 2:
                 continue  # nearly equal singular values: the vector is barely defined
             np.testing.assert_allclose(abs(vecs[:, i] @ vt[i]), 1.0, atol=1e-6)
+
+
+def test_small_blas_runs_blas_on_one_thread_and_restores_the_count():
+    # Both routes: limiting a multithreaded BLAS, and nothing to do when it is
+    # on one thread already (as in a joblib worker).
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    from skmotion.decomposition._clip_svd import small_blas
+
+    def blas_threads():
+        return [lib["num_threads"] for lib in threadpool_info() if lib["user_api"] == "blas"]
+
+    before = blas_threads()
+    with small_blas():
+        assert set(blas_threads()) <= {1}
+    assert blas_threads() == before
+    with threadpool_limits(limits=1, user_api="blas"):
+        with small_blas():
+            assert set(blas_threads()) <= {1}
+        assert set(blas_threads()) <= {1}
+    assert blas_threads() == before

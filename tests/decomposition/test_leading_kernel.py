@@ -99,3 +99,14 @@ def test_subspace_iteration_matches_the_svd(seed, shape, n_vectors, n_constant):
     np.testing.assert_allclose(values, lapack[0], rtol=1e-9, atol=1e-12)
     for clip, vals, vecs in zip(clips, values, vectors):
         _check_against_svd(clip, vals, vecs, n_vectors)
+
+
+def test_start_blocks_are_the_generators_draws_whatever_the_order_of_shapes():
+    # The start block is cut from a cached, growing array of draws; it must be
+    # exactly default_rng(0).standard_normal(shape) for every shape, in any order.
+    from skmotion.decomposition._leading import _start_block
+
+    for shape in [(3, 2), (60, 10), (1, 1), (200, 10), (7, 5), (40, 5), (500, 12)]:
+        block = _start_block(*shape)
+        np.testing.assert_array_equal(block, np.random.default_rng(0).standard_normal(shape))
+        assert block.flags.c_contiguous and not block.flags.writeable

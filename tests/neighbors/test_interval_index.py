@@ -178,3 +178,18 @@ def test_items_of_many_leaves_equal_each_leafs_items(seed, n_insertions):
     np.testing.assert_array_equal(
         index.leaf_sizes(leaves), [len(index.leaf_items(leaf)) for leaf in leaves]
     )
+
+
+@given(st.integers(0, 10_000), st.integers(1, 6))
+def test_one_leafs_items_equal_those_of_the_many_leaf_look_up(seed, n_insertions):
+    # One query's leaf takes a route of its own (a search per block, not the
+    # bounds of many leaves); it must give what the many-leaf look-up gives.
+    rng = np.random.default_rng(seed)
+    index = IntervalIndex([np.linspace(-1, 1, 6)[1:-1]] * 2, [0.2, 0.3])
+    for size in rng.integers(1, 30, size=n_insertions):
+        index.insert(rng.uniform(-1.2, 1.2, (size, 2)))
+    leaves = np.r_[np.arange(index._n_leaves + 2), rng.integers(0, index._n_leaves, 5)]
+    for leaf, items in zip(leaves, index.items_of_leaves(leaves)):
+        (alone,) = index.items_of_leaves(np.array([leaf]))
+        assert alone.dtype == np.intp
+        np.testing.assert_array_equal(alone, items)
