@@ -72,7 +72,8 @@ def write_results(name, rows, *, notes=""):
     lines = [
         f"# {name}",
         "",
-        f"machine: {platform.platform()}, Python {platform.python_version()}",
+        f"machine: {platform.platform()}, Python {platform.python_version()}, "
+        f"{os.cpu_count()} cores, load average at the end (1/5/15 min): {_load()}",
         "",
     ]
     if notes:
@@ -83,6 +84,14 @@ def write_results(name, rows, *, notes=""):
     (RESULTS / f"{name}.md").write_text(text)
     print(text)
     return text
+
+
+def _load():
+    """The machine's load averages, or "unknown" where the platform has none."""
+    try:
+        return " / ".join(f"{v:.1f}" for v in os.getloadavg())
+    except (AttributeError, OSError):
+        return "unknown"
 
 
 def _fmt(value):

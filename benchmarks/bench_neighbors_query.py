@@ -319,8 +319,8 @@ def main():
         "neighbors_query_cost",
         query_cost_rows(),
         notes="CPU microseconds per query (batches of 1,000 queries of 40 frames x 60 channels; "
-        "10,000 stored clips; target_recall 0.99, 7 levels). The machine was shared (load ~8 on 2 "
-        "cores): ratios within the run count.",
+        "10,000 stored clips; target_recall 0.99, 7 levels); the machine's load is in the header: "
+        "ratios within the run count.",
     )
     if "--quick" in sys.argv:
         return

@@ -263,7 +263,7 @@ def main(sizes=SIZES):
         rows,
         notes="CPU microseconds per query (batches of "
         f"{N_QUERIES} held-out queries), 1-NN. {PARAMS}. speedup = brute force / index. "
-        "The machine was shared (2 cores, load ~8); CPU times, ratios within one run.",
+        "CPU times (the machine's load is in the header); ratios within one run.",
     )
 
 
