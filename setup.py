@@ -7,17 +7,25 @@ from Cython.Build import cythonize
 from setuptools import Extension, setup
 
 # -fopenmp-simd honours the `omp simd` pragmas of _emission.h (vectorised sums) without
-# linking OpenMP.
-beam = Extension(
-    "skmotion.tree._beam",
-    ["skmotion/tree/_beam.pyx"],
-    depends=[
-        "skmotion/tree/_emission.h",
-        "skmotion/tree/_emission.pxd",
-        "skmotion/tree/_pairs.pxd",
-    ],
-    extra_compile_args=["-O3", "-fopenmp-simd"],
-)
+# linking OpenMP. The search is three modules sharing the structs of _beam_structs.pxd: the
+# search itself (_beam), its memory (_beam_memory) and its max-product passes (_beam_passes).
+beam_depends = [
+    "skmotion/tree/_beam_structs.pxd",
+    "skmotion/tree/_beam_memory.pxd",
+    "skmotion/tree/_beam_passes.pxd",
+    "skmotion/tree/_emission.h",
+    "skmotion/tree/_emission.pxd",
+    "skmotion/tree/_pairs.pxd",
+]
+beam = [
+    Extension(
+        f"skmotion.tree.{name}",
+        [f"skmotion/tree/{name}.pyx"],
+        depends=beam_depends,
+        extra_compile_args=["-O3", "-fopenmp-simd"],
+    )
+    for name in ("_beam", "_beam_memory", "_beam_passes")
+]
 # The causal stream's per-frame update (tree/_online_stream.py), the same flags.
 online = Extension(
     "skmotion.tree._online",
@@ -48,4 +56,4 @@ psi_rank = Extension(
     ["skmotion/neighbors/_psi_rank.pyx"],
     extra_compile_args=["-O3"],
 )
-setup(ext_modules=cythonize([beam, online, position_frame, leading, psi_rank]))
+setup(ext_modules=cythonize([*beam, online, position_frame, leading, psi_rank]))
