@@ -26,17 +26,27 @@ beam = [
     )
     for name in ("_beam", "_beam_memory", "_beam_passes")
 ]
-# The causal stream's per-frame update (tree/_online_stream.py), the same flags.
-online = Extension(
-    "skmotion.tree._online",
-    ["skmotion/tree/_online.pyx"],
-    depends=[
-        "skmotion/tree/_emission.h",
-        "skmotion/tree/_emission.pxd",
-        "skmotion/tree/_pairs.pxd",
-    ],
-    extra_compile_args=["-O3", "-fopenmp-simd"],
-)
+# The causal stream's per-frame update (tree/_online_stream.py), the same flags: the kernel
+# (_online), its per-frame work (_online_step) and answers (_online_answers) over the C state of
+# _online_structs.pxd, and the answers object it fills (_online_state).
+online_depends = [
+    "skmotion/tree/_online_structs.pxd",
+    "skmotion/tree/_online_answers.pxd",
+    "skmotion/tree/_online_state.pxd",
+    "skmotion/tree/_online_step.pxd",
+    "skmotion/tree/_emission.h",
+    "skmotion/tree/_emission.pxd",
+    "skmotion/tree/_pairs.pxd",
+]
+online = [
+    Extension(
+        f"skmotion.tree.{name}",
+        [f"skmotion/tree/{name}.pyx"],
+        depends=online_depends,
+        extra_compile_args=["-O3", "-fopenmp-simd"],
+    )
+    for name in ("_online", "_online_answers", "_online_state", "_online_step")
+]
 # The body frame of point trajectories, one pass over the frames (preprocessing/_position_frame).
 position_frame = Extension(
     "skmotion.preprocessing._position_frame_loops",
@@ -56,4 +66,4 @@ psi_rank = Extension(
     ["skmotion/neighbors/_psi_rank.pyx"],
     extra_compile_args=["-O3"],
 )
-setup(ext_modules=cythonize([*beam, online, position_frame, leading, psi_rank]))
+setup(ext_modules=cythonize([*beam, *online, position_frame, leading, psi_rank]))

@@ -29,10 +29,10 @@ subtracts its per-clip sum from the scores.
 scratch, in :mod:`skmotion.tree._beam_memory`), then runs one search after
 another (:func:`_search`: steps 1, 2 and 4, with :func:`_score_layer` for step 3)
 and, for ``"prune"``, the lists of the problems still live (:func:`_prune`). The
-max-product passes over a layer's candidates (steps 3 and 4) are in
-:mod:`skmotion.tree._beam_passes`; the structs all three share are declared in
-``_beam_structs.pxd``. The arrays it reads are laid out by
-:mod:`skmotion.tree._layout`.
+max-product passes over a layer's candidates, which :func:`_keep` and
+:func:`_score` call, are in :mod:`skmotion.tree._beam_passes`; the structs the
+three modules share are declared in ``_beam_structs.pxd``. The arrays it reads
+are laid out by :mod:`skmotion.tree._layout`.
 """
 
 import numpy as np
@@ -40,7 +40,7 @@ import numpy as np
 from libc.math cimport INFINITY, NAN, log
 
 from skmotion.tree._beam_memory cimport _allocate, _gaussians, _release
-from skmotion.tree._beam_passes cimport _best_all, _max_marginals, _score, _steps
+from skmotion.tree._beam_passes cimport _best, _best_all, _kbest, _max_marginals, _steps
 from skmotion.tree._beam_structs cimport (
     BEST, KBEST, PRUNE, Decode, Gaussians, Layer, Table, Work, _pick, intp,
 )
@@ -157,6 +157,25 @@ cdef intp _keep(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const
             kept[i] = node
             kept_emit[i] = e
     return keep
+
+
+cdef void _score(intp mode, intp n_steps, intp n_cand, intp n_paths, const Layer* lay, intp graph,
+                 const intp* cand, const double* emit, Work* w, double* scores, intp* paths,
+                 intp path_stride) noexcept nogil:
+    """One problem at one scored layer: its best score (``BEST``) or its ``n_paths`` best sequences."""
+    cdef intp i
+    cdef const unsigned char* allowed
+    if lay.score_allowed != NULL:  # the graph's prior leaves its unvisited nodes out
+        allowed = lay.score_allowed + graph * lay.k
+        for i in range(n_steps * n_cand):
+            w.masked[i] = emit[i] if cand[i] >= 0 and allowed[cand[i]] else -INFINITY
+        emit = w.masked
+    _steps(n_steps, n_cand, &lay.score, graph, cand, emit, w.moves, w.steps)
+    if mode == BEST:
+        scores[0] = _best(n_steps, n_cand, emit, w.steps, w.fwd)
+    else:
+        _kbest(n_steps, n_cand, n_paths, cand, emit, w.steps, w.delta, w.scratch, w.head, w.back, paths,
+               path_stride, scores)
 
 
 cdef void _score_layer(Decode* dec, intp s, intp l, intp n_cand, const intp* cand, const double* emit) noexcept nogil:

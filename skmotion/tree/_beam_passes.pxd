@@ -1,7 +1,7 @@
 # The max-product passes over one search's candidates (skmotion/tree/_beam_passes.pyx), cimported
 # by _beam.
 
-from skmotion.tree._beam_structs cimport Layer, Table, Work, intp
+from skmotion.tree._beam_structs cimport Table, Work, intp
 
 cdef void _steps(intp n_steps, intp n_cand, const Table* tab, intp graph, const intp* cand, const double* emit,
                  double* moves, double* steps) noexcept nogil
@@ -9,6 +9,7 @@ cdef void _max_marginals(intp n_steps, intp n_cand, const double* emit, const do
                          double* fwd, double* bwd) noexcept nogil
 cdef void _best_all(intp n_steps, intp n_cand, const Table* tab, const intp* graphs, intp n_graphs,
                     const intp* cand, const double* emit, Work* w, double* out, intp out_stride) noexcept nogil
-cdef void _score(intp mode, intp n_steps, intp n_cand, intp n_paths, const Layer* lay, intp graph,
-                 const intp* cand, const double* emit, Work* w, double* scores, intp* paths,
-                 intp path_stride) noexcept nogil
+cdef double _best(intp n_steps, intp n_cand, const double* emit, const double* steps, double* fwd) noexcept nogil
+cdef void _kbest(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const double* emit,
+                 const double* steps, double* delta, double* scratch, intp* head, intp* back, intp* paths,
+                 intp path_stride, double* scores) noexcept nogil

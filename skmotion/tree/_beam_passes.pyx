@@ -7,12 +7,12 @@ A layer's candidates form a lattice of ``n_steps`` frames by ``n_cand`` slots
 scores whose sum picks the next beam (:func:`_max_marginals`), and a scored
 problem's best score (:func:`_best`, or :func:`_best_all` for every graph of a
 search at once) or its ``n_paths`` best sequences (:func:`_kbest`, a list
-Viterbi); :func:`_score` is one problem at one scored layer.
+Viterbi).
 """
 
 from libc.math cimport INFINITY
 
-from skmotion.tree._beam_structs cimport BEST, _pick
+from skmotion.tree._beam_structs cimport _pick
 from skmotion.tree._emission cimport skm_step_all
 from skmotion.tree._pairs cimport pair_moves
 
@@ -227,22 +227,3 @@ cdef void _best_all(intp n_steps, intp n_cand, const Table* tab, const intp* gra
             if prev[j * P + q] > best:
                 best = prev[j * P + q]
         out[q * out_stride] = best
-
-
-cdef void _score(intp mode, intp n_steps, intp n_cand, intp n_paths, const Layer* lay, intp graph,
-                 const intp* cand, const double* emit, Work* w, double* scores, intp* paths,
-                 intp path_stride) noexcept nogil:
-    """One problem at one scored layer: its best score (``BEST``) or its ``n_paths`` best sequences."""
-    cdef intp i
-    cdef const unsigned char* allowed
-    if lay.score_allowed != NULL:  # the graph's prior leaves its unvisited nodes out
-        allowed = lay.score_allowed + graph * lay.k
-        for i in range(n_steps * n_cand):
-            w.masked[i] = emit[i] if cand[i] >= 0 and allowed[cand[i]] else -INFINITY
-        emit = w.masked
-    _steps(n_steps, n_cand, &lay.score, graph, cand, emit, w.moves, w.steps)
-    if mode == BEST:
-        scores[0] = _best(n_steps, n_cand, emit, w.steps, w.fwd)
-    else:
-        _kbest(n_steps, n_cand, n_paths, cand, emit, w.steps, w.delta, w.scratch, w.head, w.back, paths,
-               path_stride, scores)
