@@ -29,9 +29,9 @@ subtracts its per-clip sum from the scores.
 scratch, in :mod:`skmotion.tree._beam_memory`), then runs one search after
 another (:func:`_search`: steps 1, 2 and 4, with :func:`_score_layer` for step 3)
 and, for ``"prune"``, the lists of the problems still live (:func:`_prune`). The
-max-product passes over a layer's candidates, which :func:`_keep` and
-:func:`_score` call, are in :mod:`skmotion.tree._beam_passes`; the structs the
-three modules share are declared in ``_beam_structs.pxd``. The arrays it reads
+passes that score a problem (:func:`_best`, :func:`_best_all`, :func:`_kbest`)
+are in :mod:`skmotion.tree._beam_passes`; the structs the three modules share
+are declared in ``_beam_structs.pxd``. The arrays it reads
 are laid out by :mod:`skmotion.tree._layout`.
 """
 
@@ -40,9 +40,9 @@ import numpy as np
 from libc.math cimport INFINITY, NAN, log
 
 from skmotion.tree._beam_memory cimport _allocate, _gaussians, _release
-from skmotion.tree._beam_passes cimport _best, _best_all, _kbest, _max_marginals, _steps
+from skmotion.tree._beam_passes cimport _best, _best_all, _kbest
 from skmotion.tree._beam_structs cimport (
-    BEST, KBEST, PRUNE, Decode, Gaussians, Layer, Table, Work, _pick, intp,
+    BEST, KBEST, PRUNE, Decode, Gaussians, Layer, Table, Work, _moves_of, _pick, _same_row, intp,
 )
 from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
 
@@ -114,6 +114,56 @@ cdef intp _candidates(const Layer* lay, intp n_steps, intp width, intp search_gr
             _emissions(g, frames + t * g.d, end - t, lay.ids[child], emit + t * n_cand + c, n_cand, w.y)
             t = end
     return n_cand
+
+
+cdef void _steps(intp n_steps, intp n_cand, const Table* tab, intp graph, const intp* cand, const double* emit,
+                 double* moves, double* steps) noexcept nogil:
+    """``steps[t, i, j]``: move from slot ``i`` at ``t`` to slot ``j`` at ``t + 1``, plus ``j``'s emission.
+
+    A node stays for many frames, so the candidates of consecutive frames often
+    repeat; the moves ``(n_cand, n_cand)`` are looked up again only when they change.
+    """
+    cdef intp t, i, j, src
+    cdef double* row
+    cdef const double* move
+    for t in range(n_steps - 1):
+        if t == 0 or not (_same_row(cand + t * n_cand, cand + (t - 1) * n_cand, n_cand)
+                          and _same_row(cand + (t + 1) * n_cand, cand + t * n_cand, n_cand)):
+            for i in range(n_cand):
+                src = cand[t * n_cand + i]
+                for j in range(n_cand):
+                    moves[i * n_cand + j] = _moves_of(tab, src, cand[(t + 1) * n_cand + j])[graph]
+        for i in range(n_cand):
+            row = steps + (t * n_cand + i) * n_cand
+            move = moves + i * n_cand
+            for j in range(n_cand):
+                row[j] = move[j] + emit[(t + 1) * n_cand + j]
+
+
+cdef void _max_marginals(intp n_steps, intp n_cand, const double* emit, const double* steps,
+                         double* fwd, double* bwd) noexcept nogil:
+    """Forward and backward max-product scores; their sum is each slot's max-marginal."""
+    cdef intp t, i, j
+    cdef double best, v
+    for j in range(n_cand):
+        fwd[j] = emit[j]
+        bwd[(n_steps - 1) * n_cand + j] = 0.0
+    for t in range(1, n_steps):
+        for j in range(n_cand):
+            best = -INFINITY
+            for i in range(n_cand):
+                v = fwd[(t - 1) * n_cand + i] + steps[((t - 1) * n_cand + i) * n_cand + j]
+                if v > best:
+                    best = v
+            fwd[t * n_cand + j] = best
+    for t in range(n_steps - 2, -1, -1):
+        for i in range(n_cand):
+            best = -INFINITY
+            for j in range(n_cand):
+                v = steps[(t * n_cand + i) * n_cand + j] + bwd[(t + 1) * n_cand + j]
+                if v > best:
+                    best = v
+            bwd[t * n_cand + i] = best
 
 
 cdef intp _keep(intp n_steps, intp n_cand, intp n_paths, const intp* cand, const double* emit, bint have_emit,

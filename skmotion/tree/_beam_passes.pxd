@@ -1,12 +1,8 @@
-# The max-product passes over one search's candidates (skmotion/tree/_beam_passes.pyx), cimported
+# The scoring passes over a scored layer's candidates (skmotion/tree/_beam_passes.pyx), cimported
 # by _beam.
 
 from skmotion.tree._beam_structs cimport Table, Work, intp
 
-cdef void _steps(intp n_steps, intp n_cand, const Table* tab, intp graph, const intp* cand, const double* emit,
-                 double* moves, double* steps) noexcept nogil
-cdef void _max_marginals(intp n_steps, intp n_cand, const double* emit, const double* steps,
-                         double* fwd, double* bwd) noexcept nogil
 cdef void _best_all(intp n_steps, intp n_cand, const Table* tab, const intp* graphs, intp n_graphs,
                     const intp* cand, const double* emit, Work* w, double* out, intp out_stride) noexcept nogil
 cdef double _best(intp n_steps, intp n_cand, const double* emit, const double* steps, double* fwd) noexcept nogil

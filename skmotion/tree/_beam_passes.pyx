@@ -1,87 +1,18 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
-"""The max-product passes of the compiled beam decoder over one search's candidates.
+"""The scoring passes of the compiled beam decoder: max-product over a scored layer's candidates.
 
-A layer's candidates form a lattice of ``n_steps`` frames by ``n_cand`` slots
-(see :mod:`skmotion.tree._beam`). The passes here run over it: the step scores
-``move + emission`` (:func:`_steps`), the forward and backward max-product
-scores whose sum picks the next beam (:func:`_max_marginals`), and a scored
-problem's best score (:func:`_best`, or :func:`_best_all` for every graph of a
+A layer's candidates form a lattice of ``n_steps`` frames by ``n_cand`` slots,
+with the step scores ``move + emission`` between consecutive frames (see
+:mod:`skmotion.tree._beam`). At a scored layer a problem gets its best
+sequence's score (:func:`_best`, or :func:`_best_all` for every graph of a
 search at once) or its ``n_paths`` best sequences (:func:`_kbest`, a list
 Viterbi).
 """
 
 from libc.math cimport INFINITY
 
-from skmotion.tree._beam_structs cimport _pick
+from skmotion.tree._beam_structs cimport _moves_of, _pick, _same_row
 from skmotion.tree._emission cimport skm_step_all
-from skmotion.tree._pairs cimport pair_moves
-
-
-cdef inline const double* _moves_of(const Table* t, intp src, intp dst) noexcept nogil:
-    """``log p(src -> dst)`` in every graph, ``n_graphs`` contiguous values; -inf when either is "no node"."""
-    if t.dense != NULL:  # no search and no branch: "no node" is row and column K
-        return t.dense + ((t.k if src < 0 else src) * (t.k + 1) + (t.k if dst < 0 else dst)) * t.n_graphs
-    if src < 0 or dst < 0:
-        return t.unseen_log + t.k * t.n_graphs
-    return pair_moves(t.pair_start, t.pair_dst, t.pair_log, t.unseen_log, t.n_graphs, src, dst)
-
-
-cdef bint _same_row(const intp* a, const intp* b, intp n) noexcept nogil:
-    cdef intp i
-    for i in range(n):
-        if a[i] != b[i]:
-            return False
-    return True
-
-
-cdef void _steps(intp n_steps, intp n_cand, const Table* tab, intp graph, const intp* cand, const double* emit,
-                 double* moves, double* steps) noexcept nogil:
-    """``steps[t, i, j]``: move from slot ``i`` at ``t`` to slot ``j`` at ``t + 1``, plus ``j``'s emission.
-
-    A node stays for many frames, so the candidates of consecutive frames often
-    repeat; the moves ``(n_cand, n_cand)`` are looked up again only when they change.
-    """
-    cdef intp t, i, j, src
-    cdef double* row
-    cdef const double* move
-    for t in range(n_steps - 1):
-        if t == 0 or not (_same_row(cand + t * n_cand, cand + (t - 1) * n_cand, n_cand)
-                          and _same_row(cand + (t + 1) * n_cand, cand + t * n_cand, n_cand)):
-            for i in range(n_cand):
-                src = cand[t * n_cand + i]
-                for j in range(n_cand):
-                    moves[i * n_cand + j] = _moves_of(tab, src, cand[(t + 1) * n_cand + j])[graph]
-        for i in range(n_cand):
-            row = steps + (t * n_cand + i) * n_cand
-            move = moves + i * n_cand
-            for j in range(n_cand):
-                row[j] = move[j] + emit[(t + 1) * n_cand + j]
-
-
-cdef void _max_marginals(intp n_steps, intp n_cand, const double* emit, const double* steps,
-                         double* fwd, double* bwd) noexcept nogil:
-    """Forward and backward max-product scores; their sum is each slot's max-marginal."""
-    cdef intp t, i, j
-    cdef double best, v
-    for j in range(n_cand):
-        fwd[j] = emit[j]
-        bwd[(n_steps - 1) * n_cand + j] = 0.0
-    for t in range(1, n_steps):
-        for j in range(n_cand):
-            best = -INFINITY
-            for i in range(n_cand):
-                v = fwd[(t - 1) * n_cand + i] + steps[((t - 1) * n_cand + i) * n_cand + j]
-                if v > best:
-                    best = v
-            fwd[t * n_cand + j] = best
-    for t in range(n_steps - 2, -1, -1):
-        for i in range(n_cand):
-            best = -INFINITY
-            for j in range(n_cand):
-                v = steps[(t * n_cand + i) * n_cand + j] + bwd[(t + 1) * n_cand + j]
-                if v > best:
-                    best = v
-            bwd[t * n_cand + i] = best
 
 
 cdef double _best(intp n_steps, intp n_cand, const double* emit, const double* steps, double* fwd) noexcept nogil:

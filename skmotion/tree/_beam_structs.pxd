@@ -1,8 +1,10 @@
 # The C structs of one beam decode (skmotion/tree/_beam.pyx), shared by the modules of its stages
-# (_beam_memory: the views and scratch; _beam_passes: the max-product passes), and the one small
-# helper two of them call in their inner loops, inline so each keeps its own inlined copy.
+# (_beam_memory: the views and scratch; _beam_passes: the scoring passes), and the small helpers
+# both _beam and _beam_passes call in their inner loops, inline so each keeps its own inlined copy.
 
 from libc.math cimport INFINITY
+
+from skmotion.tree._pairs cimport pair_moves
 
 ctypedef Py_ssize_t intp
 
@@ -106,3 +108,20 @@ cdef inline intp _pick(double* scores, intp n, double* value) noexcept nogil:
     scores[arg] = -INFINITY
     value[0] = best
     return arg
+
+
+cdef inline const double* _moves_of(const Table* t, intp src, intp dst) noexcept nogil:
+    """``log p(src -> dst)`` in every graph, ``n_graphs`` contiguous values; -inf when either is "no node"."""
+    if t.dense != NULL:  # no search and no branch: "no node" is row and column K
+        return t.dense + ((t.k if src < 0 else src) * (t.k + 1) + (t.k if dst < 0 else dst)) * t.n_graphs
+    if src < 0 or dst < 0:
+        return t.unseen_log + t.k * t.n_graphs
+    return pair_moves(t.pair_start, t.pair_dst, t.pair_log, t.unseen_log, t.n_graphs, src, dst)
+
+
+cdef inline bint _same_row(const intp* a, const intp* b, intp n) noexcept nogil:
+    cdef intp i
+    for i in range(n):
+        if a[i] != b[i]:
+            return False
+    return True
