@@ -7,10 +7,12 @@ from Cython.Build import cythonize
 from setuptools import Extension, setup
 
 # -fopenmp-simd honours the `omp simd` pragmas of _emission.h (vectorised sums) without
-# linking OpenMP. The search is three modules sharing the structs of _beam_structs.pxd: the
-# search itself (_beam), its memory (_beam_memory) and its max-product passes (_beam_passes).
+# linking OpenMP. The search is four modules sharing the structs of _beam_structs.pxd: the
+# search itself (_beam), a layer's candidates and emissions (_beam_candidates), its memory
+# (_beam_memory) and the scoring passes (_beam_passes).
 beam_depends = [
     "skmotion/tree/_beam_structs.pxd",
+    "skmotion/tree/_beam_candidates.pxd",
     "skmotion/tree/_beam_memory.pxd",
     "skmotion/tree/_beam_passes.pxd",
     "skmotion/tree/_emission.h",
@@ -24,7 +26,7 @@ beam = [
         depends=beam_depends,
         extra_compile_args=["-O3", "-fopenmp-simd"],
     )
-    for name in ("_beam", "_beam_memory", "_beam_passes")
+    for name in ("_beam", "_beam_candidates", "_beam_memory", "_beam_passes")
 ]
 # The causal stream's per-frame update (tree/_online_stream.py), the same flags: the kernel
 # (_online), its per-frame work (_online_step) and answers (_online_answers) over the C state of

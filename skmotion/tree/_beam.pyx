@@ -27,7 +27,8 @@ subtracts its per-clip sum from the scores.
 
 :func:`decode_searches` allocates once (:func:`_allocate`, the longest search's
 scratch, in :mod:`skmotion.tree._beam_memory`), then runs one search after
-another (:func:`_search`: steps 1, 2 and 4, with :func:`_score_layer` for step 3)
+another (:func:`_search`: steps 1 and 2 in :mod:`skmotion.tree._beam_candidates`,
+step 4, and :func:`_score_layer` for step 3)
 and, for ``"prune"``, the lists of the problems still live (:func:`_prune`). The
 passes that score a problem (:func:`_best`, :func:`_best_all`, :func:`_kbest`)
 are in :mod:`skmotion.tree._beam_passes`; the structs the three modules share
@@ -37,83 +38,17 @@ are laid out by :mod:`skmotion.tree._layout`.
 
 import numpy as np
 
-from libc.math cimport INFINITY, NAN, log
+from libc.math cimport INFINITY, log
 
+from skmotion.tree._beam_candidates cimport _candidates
 from skmotion.tree._beam_memory cimport _allocate, _gaussians, _release
 from skmotion.tree._beam_passes cimport _best, _best_all, _kbest
 from skmotion.tree._beam_structs cimport (
-    BEST, KBEST, PRUNE, Decode, Gaussians, Layer, Table, Work, _moves_of, _pick, _same_row, intp,
+    BEST, KBEST, PRUNE, Decode, Layer, Table, Work, _moves_of, _pick, _same_row, intp,
 )
-from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
 
 #: What a call computes per problem; see :func:`decode_searches`.
 MODES = ("best", "kbest", "prune")
-
-
-cdef inline void _emissions(const Gaussians* g, const double* x, intp n, intp node, double* out, intp stride,
-                            double* y) noexcept nogil:
-    """Log densities of ``n`` consecutive frames from ``x`` under tree node ``node``'s Gaussian.
-
-    Written to ``out[i * stride]``; ``y`` is scratch of ``4 d`` doubles.
-    """
-    cdef intp row
-    if g.full:
-        row = g.lr_start[node]
-        if row >= 0:
-            skm_lowrank_run(x, n, g.d, g.means + node * g.d, g.lr_vectors + row * g.d, g.lr_weights + row,
-                            g.lr_rank[node], g.lr_inv_floor[node], g.const_[node], out, stride, y)
-        else:
-            skm_full_run(x, n, g.d, g.prec + node * g.d * g.d, g.shifts + node * g.d, g.const_[node], out, stride,
-                         y)
-    else:
-        skm_diag_run(x, n, g.d, g.means + node * g.d, g.prec + node * g.d, g.const_[node], out, stride)
-
-
-cdef intp _candidates(const Layer* lay, intp n_steps, intp width, intp search_graph, bint carry,
-                      const Gaussians* g, const double* frames, Work* w, intp* cand, double* emit,
-                      bint emissions) noexcept nogil:
-    """Each frame's candidates (children of its kept nodes) and, with ``emissions``, their log densities.
-
-    A leaf copied down is its own only child: with ``carry`` (the kept nodes'
-    emissions are known) its emission is carried, not recomputed. The others
-    are computed per run of frames whose slot holds the same node. Returns the
-    candidates per frame.
-    """
-    cdef intp t, side, j, c, node, child, end, n_cand = 2 * width
-    cdef const unsigned char* allowed = (lay.search_allowed + search_graph * lay.k
-                                         if lay.search_allowed != NULL else NULL)
-    for t in range(n_steps):
-        for side in range(2):
-            for j in range(width):
-                c = t * n_cand + side * width + j
-                node = w.beam[t * width + j]
-                child = -1 if node < 0 else lay.children[2 * node + side]
-                if child >= 0 and allowed != NULL and not allowed[child]:
-                    child = -1
-                cand[c] = child
-                if not emissions:
-                    continue
-                if child < 0:
-                    emit[c] = -INFINITY
-                elif carry and side == 0 and lay.children[2 * node + 1] < 0:
-                    emit[c] = w.beam_emit[t * width + j]
-                else:
-                    emit[c] = NAN  # to compute, below
-    if not emissions:
-        return n_cand
-    for c in range(n_cand):
-        t = 0
-        while t < n_steps:
-            if emit[t * n_cand + c] == emit[t * n_cand + c]:  # known (not NaN)
-                t += 1
-                continue
-            child = cand[t * n_cand + c]
-            end = t + 1
-            while end < n_steps and cand[end * n_cand + c] == child and emit[end * n_cand + c] != emit[end * n_cand + c]:
-                end += 1
-            _emissions(g, frames + t * g.d, end - t, lay.ids[child], emit + t * n_cand + c, n_cand, w.y)
-            t = end
-    return n_cand
 
 
 cdef void _steps(intp n_steps, intp n_cand, const Table* tab, intp graph, const intp* cand, const double* emit,
