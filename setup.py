@@ -1,4 +1,5 @@
-"""The compiled part of skmotion: the beam Viterbi's inner loops.
+"""The compiled parts of skmotion: the motion database's decoders, the online stream,
+the body frame of point trajectories, and the similarity search's eigenpairs and psi.
 
 Everything else is in pyproject.toml.
 """
@@ -53,7 +54,7 @@ leading = Extension(
     ["skmotion/decomposition/_leading.pyx"],
     extra_compile_args=["-O3"],
 )
-# psi distances of a leaf's queries to its candidates (neighbors/_interval_neighbors.py).
+# psi distances of a leaf's queries to its candidates (neighbors/_ranking.py).
 psi_rank = Extension(
     "skmotion.neighbors._psi_rank",
     ["skmotion/neighbors/_psi_rank.pyx"],
