@@ -110,6 +110,15 @@ cdef int _top_pairs(int n, int n_pairs, double* gram, double* values, double* ve
     return info
 
 
+cdef inline double _norm(const double* v, int n) noexcept nogil:
+    """The Euclidean norm of ``v[:n]``, summed in order (the same rounding at every call)."""
+    cdef double total = 0.0
+    cdef int i
+    for i in range(n):
+        total += v[i] * v[i]
+    return sqrt(total)
+
+
 cdef bint _power(int n, double* gram, double* x, double* y, double* value,
                  double tolerance, int check, int max_steps) noexcept nogil:
     """The leading eigenpair of ``gram`` (lower triangle) by power steps, into ``x``, ``value``.
@@ -119,7 +128,7 @@ cdef bint _power(int n, double* gram, double* x, double* y, double* value,
     """
     cdef char uplo = b"L"
     cdef int one = 1, step, i, j
-    cdef double alpha = 1.0, beta = 0.0, norm = 0.0, rayleigh, residual, entry
+    cdef double alpha = 1.0, beta = 0.0, norm, rayleigh, residual, entry
     for i in range(n):
         x[i] = 0.0
     for j in range(n):  # column j of the lower triangle: rows j..n-1
@@ -129,9 +138,7 @@ cdef bint _power(int n, double* gram, double* x, double* y, double* value,
             if i != j:
                 x[j] += entry
         x[j] += gram[j]  # first column: G[j, 0] = lower entry (j, 0)
-    for i in range(n):
-        norm += x[i] * x[i]
-    norm = sqrt(norm)
+    norm = _norm(x, n)
     if norm == 0.0:
         return False
     for i in range(n):
@@ -148,10 +155,7 @@ cdef bint _power(int n, double* gram, double* x, double* y, double* value,
             if sqrt(residual) <= tolerance * fabs(rayleigh):
                 value[0] = rayleigh
                 return True
-        norm = 0.0
-        for i in range(n):
-            norm += y[i] * y[i]
-        norm = sqrt(norm)
+        norm = _norm(y, n)
         if norm == 0.0:
             return False
         for i in range(n):
@@ -381,10 +385,7 @@ cdef int _one_clip(const double* clip, int n_frames, int n_channels, int n_vecto
         else:  # v = A^T w = B w (into gram, no longer needed), then unit norm
             _dgemv(&no, &n_channels, &n_frames, &alpha, <double*>a, &n_channels,
                    s.pairs + j * n, &one, &beta, s.gram, &one)
-            norm = 0.0
-            for i in range(n_channels):
-                norm += s.gram[i] * s.gram[i]
-            norm = sqrt(norm)
+            norm = _norm(s.gram, n_channels)
             for i in range(n_channels):
                 vectors[i * n_vectors + j] = s.gram[i] / norm if norm > 0.0 else 0.0
     return info

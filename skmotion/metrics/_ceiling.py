@@ -106,19 +106,20 @@ def pruning_ceiling(distances, y_query, y_stored, *, min_recall=1.0):
         raise ValueError(f"distances[{row}, {column}] is NaN.")
     relevant = y_query[:, None] == y_stored[None, :]
     has_similar, has_other = relevant.any(axis=1), (~relevant).any(axis=1)
-    if not has_other.any():
+    # the means of recall and pruning run over the queries where each is defined
+    n_similar, n_other = np.count_nonzero(has_similar), np.count_nonzero(has_other)
+    if not n_other:
         return float("nan")
     base, steps = 0.0, []
     for q in range(len(y_query)):
         found, pruned = _ball_options(distances[q], relevant[q], ~relevant[q])
-        gains = pruned / has_other.sum() if has_other[q] else np.zeros_like(pruned)
+        gains = pruned / n_other if has_other[q] else np.zeros_like(pruned)
         if not has_similar[q]:  # nothing to keep: the empty ball costs no recall
             base += gains[-1]
             continue
         base += gains[0]
-        costs = (1.0 - found) / has_similar.sum()
-        steps.extend(zip(*_upper_hull(costs, gains)))
-    budget = 1.0 - min_recall if has_similar.any() else 0.0
+        steps.extend(zip(*_upper_hull((1.0 - found) / n_similar, gains)))
+    budget = 1.0 - min_recall if n_similar else 0.0
     for slope, width in sorted(steps, key=lambda step: -step[0]):
         if budget <= 1e-12:
             break

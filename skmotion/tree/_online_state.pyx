@@ -16,6 +16,16 @@ from libc.string cimport memcpy
 
 KEYS = ("frame", "node", "nodes", "lagged_node", "proba", "label", "next_nodes", "next_proba")
 
+
+cdef object _doubles(const double* source, Py_ssize_t n):
+    """A new float64 array holding a copy of ``source[:n]``."""
+    out = np.empty(n)
+    cdef double[::1] view = out
+    if n:
+        memcpy(&view[0], source, n * sizeof(double))
+    return out
+
+
 cdef class OnlineState:
     """The stream's answers after an update; attributes, or keys as in a ``Bunch``.
 
@@ -63,22 +73,14 @@ cdef class OnlineState:
 
     @property
     def proba(self):
-        cdef double[::1] view
         if self._proba is None:
-            self._proba = np.empty(self.n_classes)
-            view = self._proba
-            if self.n_classes:
-                memcpy(&view[0], self.proba_buf, self.n_classes * sizeof(double))
+            self._proba = _doubles(self.proba_buf, self.n_classes)
         return self._proba
 
     @property
     def next_proba(self):
-        cdef double[::1] view
         if self._next_proba is None:
-            self._next_proba = np.empty(self.n_best)
-            view = self._next_proba
-            if self.n_best:
-                memcpy(&view[0], self.proba_buf + self.n_classes, self.n_best * sizeof(double))
+            self._next_proba = _doubles(self.proba_buf + self.n_classes, self.n_best)
         return self._next_proba
 
     @property
