@@ -58,12 +58,16 @@ def _joint_angles():
     return data.clips, data.target
 
 
+def _logprob_and_paths(logprob, paths):
+    return [logprob, *paths]
+
+
 CASES = {
     "MotionTreeHMM": (
         MotionTreeHMM(max_depth=3, min_samples_leaf=4),
         _motions,
         lambda est, X: {
-            "decode": _as_list(est.decode(X)),
+            "decode": _logprob_and_paths(*est.decode(X)),
             "windows": _as_list(est.predict_proba_windows(X, 20, 7)),
         },
     ),

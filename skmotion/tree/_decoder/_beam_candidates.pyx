@@ -1,7 +1,7 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
 """A layer's candidates in the compiled beam decoder, and their Gaussian log densities.
 
-Steps 1 and 2 of :mod:`skmotion.tree._beam`: each frame's candidates at a
+Steps 1 and 2 of :mod:`skmotion.tree._decoder._beam`: each frame's candidates at a
 layer are the children of its kept nodes at the layer above, and their
 emissions ``log Po(x | k)`` are computed by the loops of ``_emission.h`` over
 runs of frames whose slot holds the same node (a copied leaf's is carried).
@@ -9,7 +9,7 @@ runs of frames whose slot holds the same node (a copied leaf's is carried).
 
 from libc.math cimport INFINITY, NAN
 
-from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
+from skmotion.tree._decoder._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
 
 
 cdef inline void _emissions(const Gaussians* g, const double* x, intp n, intp node, double* out, intp stride,

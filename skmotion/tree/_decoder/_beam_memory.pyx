@@ -1,14 +1,14 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
 """The compiled beam decoder's memory: C views of the caller's arrays, and the scratch.
 
-:func:`_allocate` fills a :c:type:`Decode` (see :mod:`skmotion.tree._beam`)
-with the layers' views of the arrays :mod:`skmotion.tree._layout` lays out
+:func:`_allocate` fills a :c:type:`Decode` (see :mod:`skmotion.tree._decoder._beam`)
+with the layers' views of the arrays :mod:`skmotion.tree._decoder._tables` lays out
 and with the scratch of the longest search; :func:`_release` frees it all.
 """
 
 from libc.stdlib cimport free, malloc
 
-from skmotion.tree._beam_structs cimport PRUNE, Layer, Table, Work
+from skmotion.tree._decoder._beam_structs cimport PRUNE, Layer, Table, Work
 
 
 cdef Gaussians _gaussians(object gauss):

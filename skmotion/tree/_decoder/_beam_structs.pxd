@@ -1,11 +1,11 @@
-# The C structs of one beam decode (skmotion/tree/_beam.pyx), shared by the modules of its stages
+# The C structs of one beam decode (skmotion/tree/_decoder/_beam.pyx), shared by the modules of its stages
 # (_beam_candidates: a layer's candidates and emissions; _beam_memory: the views and scratch;
 # _beam_passes: the scoring passes), and the small helpers both _beam and _beam_passes call in
 # their inner loops, inline so each keeps its own inlined copy.
 
 from libc.math cimport INFINITY
 
-from skmotion.tree._pairs cimport pair_moves
+from skmotion.tree._decoder._pairs cimport pair_moves
 
 ctypedef Py_ssize_t intp
 

@@ -1,6 +1,6 @@
 """The compiled decoder's view of a motion tree and its graphs: arrays made once per object.
 
-:mod:`skmotion.tree._beam` reads plain C arrays. This module lays a
+:mod:`skmotion.tree._decoder._beam` reads plain C arrays. This module lays a
 :class:`MotionTree`'s Gaussians and children and a :class:`TransitionGraphs`'
 log probabilities out that way, the first time a decoder asks, and keeps
 them while the object lives (a weak-keyed cache: the data structures carry

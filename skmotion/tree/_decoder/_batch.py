@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from skmotion.tree._decode import beam_decode
+from skmotion.tree._decoder._decode import beam_decode
 from skmotion.utils._parallel import parallel_map
 
 __all__ = ["decode_clips", "length_groups"]
@@ -33,7 +33,7 @@ def length_groups(lengths, n_graphs, budget=_GROUP_PAIRS):
     Examples
     --------
     >>> import numpy as np
-    >>> from skmotion.tree._batch import length_groups
+    >>> from skmotion.tree._decoder._batch import length_groups
     >>> [g.tolist() for g in length_groups(np.array([5, 50, 6, 40]), n_graphs=1, budget=80)]
     [[0, 2], [3], [1]]
     """

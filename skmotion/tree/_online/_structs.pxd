@@ -1,8 +1,8 @@
-# The C state of the online stream's kernel (skmotion/tree/_online.pyx), shared by the modules that
-# run it: _online_step (a frame through every layer) and _online_answers (the answers after it); and
+# The C state of the online stream's kernel (skmotion/tree/_online/_kernel.pyx), shared by the modules that
+# run it: _step (a frame through every layer) and _answers (the answers after it); and
 # the small helpers of their inner loops, inline so each module keeps its own inlined copy.
 
-from skmotion.tree._pairs cimport pair_moves
+from skmotion.tree._decoder._pairs cimport pair_moves
 
 ctypedef Py_ssize_t intp
 

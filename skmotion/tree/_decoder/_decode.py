@@ -19,9 +19,9 @@ reference and small problems.
 import numpy as np
 from scipy.special import logsumexp
 
-from skmotion.tree._beam import decode_searches
-from skmotion.tree._layout import children_table, gaussian_arrays, transition_table
-from skmotion.tree._viterbi import kbest_viterbi
+from skmotion.tree._decoder._beam import decode_searches
+from skmotion.tree._decoder._tables import children_table, gaussian_arrays, transition_table
+from skmotion.tree._decoder._viterbi import kbest_viterbi
 from skmotion.utils._validation import check_int
 
 __all__ = ["NODE_PRIORS", "beam_decode", "exhaustive_viterbi", "node_log_posterior"]
@@ -152,7 +152,7 @@ def _kernel_allowed(graphs, layer, node_prior):
 def _layer_specs(tree, search, scored, layer, node_prior, mask_scored):
     """What the compiled decoder reads of layers ``1 .. layer`` (entry 0 unused).
 
-    See ``decode_searches``; the per-object arrays come from :mod:`skmotion.tree._layout`.
+    See ``decode_searches``; the per-object arrays come from :mod:`skmotion.tree._decoder._tables`.
     """
     specs = [None]
     for depth in range(1, layer + 1):

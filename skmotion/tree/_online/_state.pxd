@@ -1,4 +1,4 @@
-# The stream's answers object (skmotion/tree/_online_state.pyx), cimported by _online, whose kernel
+# The stream's answers object (skmotion/tree/_online/_state.pyx), cimported by _online, whose kernel
 # fills its C buffers directly.
 
 

@@ -44,7 +44,7 @@ class Moments:
     Examples
     --------
     >>> import numpy as np
-    >>> from skmotion.tree._moments import Moments
+    >>> from skmotion.tree._growth._moments import Moments
     >>> rng = np.random.default_rng(0)
     >>> a, b = rng.normal(size=(5, 3)), rng.normal(size=(7, 3))
     >>> merged = Moments.of(a, [0], "full").merged(Moments.of(b, [0], "full"))

@@ -3,7 +3,7 @@
 Yamane, Yamaguchi and Nakamura build their database once, from all frames, and
 list incremental learning as future work. Here new frames are routed down the
 existing splits; every node they pass through merges their moments exactly
-(:class:`~skmotion.tree._moments.Moments`), and the transition counts of their
+(:class:`~skmotion.tree._growth._moments.Moments`), and the transition counts of their
 clips are added to the graphs. Local changes keep the tree the one the build
 would make:
 
@@ -15,7 +15,7 @@ would make:
   subtree was built has the subtree grown again from its frames: its axis and
   cut were chosen on a part of the frames it holds now. At the root this is
   the whole database, built again as ``fit`` builds it from all clips so far
-  (standardisation included: see ``_partial_fit``);
+  (standardisation included: see ``MotionTreeHMM.partial_fit``);
 - a split node whose mean has moved more than ``rebuild_tol`` of its standard
   deviation (``sqrt(trace(cov) / d)`` when the split was made) is rebuilt
   locally too.
@@ -32,7 +32,7 @@ from numbers import Real
 import numpy as np
 
 from skmotion.tree._build import build_nodes
-from skmotion.tree._moments import Moments
+from skmotion.tree._growth._moments import Moments
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._transitions import TransitionGraphs
 
@@ -46,7 +46,10 @@ __all__ = [
 
 
 def check_growth_params(split_growth, rebuild_tol, rebuild_growth=None):
-    """Check the growth parameters: the two growths None or > 1, ``rebuild_tol`` None or > 0."""
+    """Check the growth parameters: the two growths None or > 1, ``rebuild_tol`` None or > 0.
+
+    Returns them as the keywords of :meth:`LiveDatabase.add`.
+    """
     for name, value in (("split_growth", split_growth), ("rebuild_growth", rebuild_growth)):
         if value is not None and not (
             isinstance(value, Real) and not isinstance(value, bool) and value > 1
@@ -56,6 +59,11 @@ def check_growth_params(split_growth, rebuild_tol, rebuild_growth=None):
         isinstance(rebuild_tol, Real) and not isinstance(rebuild_tol, bool) and rebuild_tol > 0
     ):
         raise ValueError(f"rebuild_tol must be a positive number or None; got {rebuild_tol!r}.")
+    return {
+        "split_growth": split_growth,
+        "rebuild_growth": rebuild_growth,
+        "rebuild_tol": rebuild_tol,
+    }
 
 
 def node_moments(tree, frames, kind, n_nodes=None):
@@ -164,24 +172,29 @@ class LiveDatabase:
         The clips seen so far, as given (None: unknown, the tree came from ``fit``).
     center, scale : ndarray of shape (n_channels,)
         The standardisation of the tree's frames: ``(clip - center) / scale``.
+    labels : list, default=None
+        The label of each clip (kept with the clips: the graphs are counted
+        again from them when the tree's layers change).
     """
 
-    def __init__(self, tree, moments, clips, center, scale):
+    def __init__(self, tree, moments, clips, center, scale, labels=None):
         self.tree = tree
         self.moments = moments
         self.clips = clips
+        self.labels = None if clips is None else list(labels)
         self.center, self.scale = center, scale
         self.checked = moments.count.copy()
         self.split_mean = moments.mean.copy()
         self.split_scale = _spread(moments)
 
     @classmethod
-    def from_clips(cls, tree, clips, center, scale):
+    def from_clips(cls, tree, clips, labels, center, scale):
         """For a tree built from these clips (or any tree they are routed through)."""
         # copies: the caller may change its arrays
         clips = [np.array(c, dtype=np.float64) for c in clips]
         frames = (np.concatenate(clips) - center) / scale
-        return cls(tree, node_moments(tree, frames, tree.covariance_type), clips, center, scale)
+        moments = node_moments(tree, frames, tree.covariance_type)
+        return cls(tree, moments, clips, center, scale, labels)
 
     @classmethod
     def from_tree(cls, tree, center, scale):
@@ -196,8 +209,8 @@ class LiveDatabase:
         clips = self.clips if clips is None else clips
         return (np.concatenate(clips) - self.center) / self.scale
 
-    def add(self, clips, *, split_growth, rebuild_growth, rebuild_tol, build_params):
-        """Merge new clips; split and rebuild where due (the root excepted: see ``_partial_fit``).
+    def add(self, clips, labels, *, split_growth, rebuild_growth, rebuild_tol, build_params):
+        """Merge new clips; split and rebuild where due (the root excepted: ``root_due``).
 
         Returns whether the tree's structure changed.
         """
@@ -213,6 +226,7 @@ class LiveDatabase:
             self.tree = _with_moments(tree, self.moments, low_rank)
             return False
         self.clips.extend(np.array(c, dtype=np.float64) for c in clips)
+        self.labels.extend(labels)
         regrow = self._due(split_growth, rebuild_growth, rebuild_tol, build_params)
         if not regrow:
             self.tree = _with_moments(tree, self.moments, low_rank)

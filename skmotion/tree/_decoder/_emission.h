@@ -1,4 +1,4 @@
-/* Vectorised loops of the compiled decoder (skmotion/tree/_beam.pyx): Gaussian log densities.
+/* Vectorised loops of the compiled decoder (skmotion/tree/_decoder/_beam.pyx): Gaussian log densities.
  *
  * Each density is a sum over the channels. Written as a plain loop, the sum is a
  * chain of dependent additions that a compiler may not reorder (that would change

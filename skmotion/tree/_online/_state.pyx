@@ -1,10 +1,11 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
 """The online stream's answers after an update (:class:`OnlineState`), filled in C and read lazily.
 
-The kernel (:class:`~skmotion.tree._online.OnlineKernel`) writes a state's C
-buffers directly (their fields are declared in ``_online_state.pxd``); the
+The kernel (:class:`~skmotion.tree._online._kernel.OnlineKernel`) writes a state's C
+buffers directly (their fields are declared in ``_state.pxd``); the
 arrays are made on first access. A state pickles through
-:func:`skmotion.tree._online._from_values`, the name earlier pickles hold.
+:func:`_from_values` (pickles made before the ``_online`` sub-package name it
+``skmotion.tree._online._from_values``, which the package re-exports).
 """
 
 from collections.abc import Mapping
@@ -137,10 +138,17 @@ cdef class OnlineState:
         return f"OnlineState(frame={self.frame}, node={self.node}, label={self.label!r})"
 
     def __reduce__(self):
-        # the unpickler stays in skmotion.tree._online, where pickles made before the split look
-        from skmotion.tree._online import _from_values
-
         return (_from_values, (dict(self.items()),))
+
+
+def _from_values(values):
+    """An OnlineState holding given answers (unpickling)."""
+    cdef OnlineState out = OnlineState.__new__(OnlineState)
+    out.frame, out.node, out.lagged_node = values["frame"], values["node"], values["lagged_node"]
+    out._nodes, out._proba, out._label = values["nodes"], values["proba"], values["label"]
+    out._next_nodes, out._next_proba = values["next_nodes"], values["next_proba"]
+    out.n_classes, out.n_best = len(out._proba), len(out._next_nodes)
+    return out
 
 
 Mapping.register(OnlineState)

@@ -1,8 +1,8 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
 """The online stream's per-frame work: one frame through every layer.
 
-Steps 1 to 5 of :mod:`skmotion.tree._online`, as functions of the kernel's C
-state (a ``Kernel`` of ``_online_structs.pxd``, held by
+Steps 1 to 5 of :mod:`skmotion.tree._online._kernel`, as functions of the kernel's C
+state (a ``Kernel`` of ``_structs.pxd``, held by
 :class:`~skmotion.tree._online.OnlineKernel`): a layer's candidates and their
 densities (:func:`_candidates`), the global graph's forward step
 (:func:`_forward`, over the moves :func:`_move_table` keeps), the kept nodes
@@ -12,8 +12,8 @@ densities (:func:`_candidates`), the global graph's forward step
 
 from libc.math cimport INFINITY
 
-from skmotion.tree._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
-from skmotion.tree._online_structs cimport Layer, _moves, _push
+from skmotion.tree._decoder._emission cimport skm_diag_run, skm_full_run, skm_lowrank_run
+from skmotion.tree._online._structs cimport Layer, _moves, _push
 
 
 cdef double _density(Kernel* k, const double* x, intp node) noexcept nogil:

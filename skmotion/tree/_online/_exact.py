@@ -21,7 +21,7 @@ import numpy as np
 from sklearn.utils import Bunch
 
 from skmotion.tree._calibration import log_softmax_rows, per_frame, sum_of_paths
-from skmotion.tree._decode import beam_decode
+from skmotion.tree._decoder._decode import beam_decode
 from skmotion.tree._transitions import TransitionGraphs
 from skmotion.utils._validation import check_int
 

@@ -1,5 +1,5 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
-"""Compiled per-frame update of the causal top-down beam (see :mod:`skmotion.tree._online_stream`).
+"""Compiled per-frame update of the causal top-down beam (see :mod:`skmotion.tree._online._causal`).
 
 One call of :meth:`OnlineKernel.advance` takes a chunk of standardised frames
 and, frame after frame, layer after layer (``1 .. n_layers``), with no Python
@@ -28,12 +28,12 @@ holds only pointers to them and to the model's tables.
 
 A single float64 frame can go through :meth:`OnlineKernel.step`, which checks
 its buffer in C (no Python between the call and the frame's work); the answers
-come back as an :class:`~skmotion.tree._online_state.OnlineState`, filled in C
+come back as an :class:`~skmotion.tree._online._state.OnlineState`, filled in C
 and read lazily.
 
-The kernel's C fields are one struct (``Kernel``, in ``_online_structs.pxd``):
-the per-frame work (steps 1 to 5) is in :mod:`skmotion.tree._online_step` and
-the answers in :mod:`skmotion.tree._online_answers`, functions of that struct
+The kernel's C fields are one struct (``Kernel``, in ``_structs.pxd``):
+the per-frame work (steps 1 to 5) is in :mod:`skmotion.tree._online._step` and
+the answers in :mod:`skmotion.tree._online._answers`, functions of that struct
 (calls within a module, which the compiler inlines); this module holds the
 class, its setup and its Python entry points.
 """
@@ -41,13 +41,10 @@ class, its setup and its Python entry points.
 from cpython.buffer cimport PyBUF_C_CONTIGUOUS, PyBUF_FORMAT, PyBuffer_Release, PyObject_GetBuffer
 from libc.stdlib cimport free, malloc
 
-from skmotion.tree._online_answers cimport _next, _posterior
-from skmotion.tree._online_state cimport OnlineState as State  # the C type, its fields
-from skmotion.tree._online_step cimport _frame
-from skmotion.tree._online_structs cimport Kernel, Layer, intp
-
-# importable from here as before the split
-from skmotion.tree._online_state import KEYS, OnlineState  # noqa: F401
+from skmotion.tree._online._answers cimport _next, _posterior
+from skmotion.tree._online._state cimport OnlineState as State  # the C type, its fields
+from skmotion.tree._online._step cimport _frame
+from skmotion.tree._online._structs cimport Kernel, Layer, intp
 
 
 cdef class OnlineKernel:
@@ -62,12 +59,12 @@ cdef class OnlineKernel:
         Entry ``l - 1`` for layer ``l``: ``(children, ids, pair_start,
         pair_dst, pair_log, unseen_log, allowed, log_norm, scored)``.
     state : dict
-        The stream's arrays (see :class:`~skmotion.tree._online_stream.OnlineMotionStream`).
+        The stream's arrays (see :class:`~skmotion.tree._online._causal.OnlineMotionStream`).
     beam, n_graphs, n_paths, stream_layer, ring : int
     """
 
     cdef object _keep              # the arrays the pointers point into
-    cdef Kernel k                  # the C state the compiled loops read (_online_structs.pxd)
+    cdef Kernel k                  # the C state the compiled loops read (_structs.pxd)
     # the answers (set by `answers`): what `result` and the single-frame `step` need
     cdef object _answers     # (model, tree, classes, ancestors, arrays kept alive)
     cdef const intp* class_of_graph
@@ -341,12 +338,3 @@ cdef class OnlineKernel:
             slot = self.k.ring_back[((t - i) % self.k.ring) * self.k.slots + slot]
         return self.k.ring_cand[((t - lag) % self.k.ring) * self.k.slots + slot]
 
-
-def _from_values(values):
-    """An OnlineState holding given answers (unpickling)."""
-    cdef State out = State.__new__(State)
-    out.frame, out.node, out.lagged_node = values["frame"], values["node"], values["lagged_node"]
-    out._nodes, out._proba, out._label = values["nodes"], values["proba"], values["label"]
-    out._next_nodes, out._next_proba = values["next_nodes"], values["next_proba"]
-    out.n_classes, out.n_best = len(out._proba), len(out._next_nodes)
-    return out

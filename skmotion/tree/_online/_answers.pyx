@@ -4,13 +4,13 @@
 The class posterior (:func:`_posterior`, from each graph's ``n_paths`` best
 sequences summed at every scored layer, :func:`_sum_of_paths`) and the most
 likely next nodes (:func:`_next`); :class:`~skmotion.tree._online.OnlineKernel`
-writes them into an :class:`~skmotion.tree._online_state.OnlineState`.
+writes them into an :class:`~skmotion.tree._online._state.OnlineState`.
 """
 
 from libc.math cimport INFINITY, exp, log1p
 from libc.stdlib cimport free, malloc
 
-from skmotion.tree._online_structs cimport Table, _push
+from skmotion.tree._online._structs cimport Table, _push
 
 
 cdef double _sum_of_paths(Kernel* k, intp l, intp g) noexcept nogil:

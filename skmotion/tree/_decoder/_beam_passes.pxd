@@ -1,7 +1,7 @@
-# The scoring passes over a scored layer's candidates (skmotion/tree/_beam_passes.pyx), cimported
+# The scoring passes over a scored layer's candidates (skmotion/tree/_decoder/_beam_passes.pyx), cimported
 # by _beam.
 
-from skmotion.tree._beam_structs cimport Table, Work, intp
+from skmotion.tree._decoder._beam_structs cimport Table, Work, intp
 
 cdef void _best_all(intp n_steps, intp n_cand, const Table* tab, const intp* graphs, intp n_graphs,
                     const intp* cand, const double* emit, Work* w, double* out, intp out_stride) noexcept nogil

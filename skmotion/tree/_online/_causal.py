@@ -38,15 +38,15 @@ most ``2 beam``), their scores under the global and the class graphs, plus, at
 the stream's layer, ``lag + 1`` frames of candidates and back-pointers for the
 fixed-lag answer: ``O(beam x layers x n_graphs x n_paths + beam x lag)`` numbers, and a
 frame costs the same whatever came before. The per-frame loop is compiled
-(:mod:`skmotion.tree._online`).
+(:mod:`skmotion.tree._online._kernel`).
 """
 
 import numpy as np
 
 from skmotion.tree._calibration import sum_of_paths
-from skmotion.tree._decode import _log_normaliser
-from skmotion.tree._online import OnlineKernel
-from skmotion.tree._stream import layer_ancestors, stream_args, update_frames
+from skmotion.tree._decoder._decode import _log_normaliser
+from skmotion.tree._online._exact import layer_ancestors, stream_args, update_frames
+from skmotion.tree._online._kernel import OnlineKernel
 from skmotion.utils._validation import check_int
 
 __all__ = ["OnlineMotionStream"]
@@ -55,7 +55,7 @@ __all__ = ["OnlineMotionStream"]
 def _gaussian_arrays(tree):
     """The tree's Gaussians as the compiled decoders read them (one layout for both kernels)."""
     try:  # where the decoders' layouts are kept since they left MotionTree
-        from skmotion.tree._layout import gaussian_arrays
+        from skmotion.tree._decoder._tables import gaussian_arrays
     except ImportError:
         return tree.kernel_gaussians()
     return gaussian_arrays(tree)

@@ -3,7 +3,7 @@
 
 A layer's candidates form a lattice of ``n_steps`` frames by ``n_cand`` slots,
 with the step scores ``move + emission`` between consecutive frames (see
-:mod:`skmotion.tree._beam`). At a scored layer a problem gets its best
+:mod:`skmotion.tree._decoder._beam`). At a scored layer a problem gets its best
 sequence's score (:func:`_best`, or :func:`_best_all` for every graph of a
 search at once) or its ``n_paths`` best sequences (:func:`_kbest`, a list
 Viterbi).
@@ -11,8 +11,8 @@ Viterbi).
 
 from libc.math cimport INFINITY
 
-from skmotion.tree._beam_structs cimport _moves_of, _pick, _same_row
-from skmotion.tree._emission cimport skm_step_all
+from skmotion.tree._decoder._beam_structs cimport _moves_of, _pick, _same_row
+from skmotion.tree._decoder._emission cimport skm_step_all
 
 
 cdef double _best(intp n_steps, intp n_cand, const double* emit, const double* steps, double* fwd) noexcept nogil:

@@ -1,5 +1,5 @@
 # cython: language_level=3, boundscheck=False, wraparound=False, initializedcheck=False, cdivision=True
-"""Compiled top-down beam Viterbi (see :mod:`skmotion.tree._decode`).
+"""Compiled top-down beam Viterbi (see :mod:`skmotion.tree._decoder._decode`).
 
 The recursions of a Viterbi pass run frame after frame, as they must; done in
 numpy they cost one Python step per frame and layer. Here one call decodes a
@@ -17,7 +17,7 @@ guide, or a problem's own graph), layer after layer, with no Python between:
    graph scores each candidate by the best sequence through it, and each frame
    keeps its ``n_paths`` best for the next layer.
 
-The arithmetic is that of the numpy reference (:mod:`skmotion.tree._viterbi`):
+The arithmetic is that of the numpy reference (:mod:`skmotion.tree._decoder._viterbi`):
 a step's score is ``move + emission`` of the arriving node, added to the score
 so far, and ties go to the lower candidate slot (or rank, then slot). Slot
 ``side * width + w`` of a frame is child ``side`` (0 left, 1 right) of its
@@ -26,24 +26,24 @@ normaliser of ``Ps`` is the same for every candidate of a frame, so the caller
 subtracts its per-clip sum from the scores.
 
 :func:`decode_searches` allocates once (:func:`_allocate`, the longest search's
-scratch, in :mod:`skmotion.tree._beam_memory`), then runs one search after
-another (:func:`_search`: steps 1 and 2 in :mod:`skmotion.tree._beam_candidates`,
+scratch, in :mod:`skmotion.tree._decoder._beam_memory`), then runs one search after
+another (:func:`_search`: steps 1 and 2 in :mod:`skmotion.tree._decoder._beam_candidates`,
 step 4, and :func:`_score_layer` for step 3)
 and, for ``"prune"``, the lists of the problems still live (:func:`_prune`). The
 passes that score a problem (:func:`_best`, :func:`_best_all`, :func:`_kbest`)
-are in :mod:`skmotion.tree._beam_passes`; the structs the three modules share
+are in :mod:`skmotion.tree._decoder._beam_passes`; the structs the three modules share
 are declared in ``_beam_structs.pxd``. The arrays it reads
-are laid out by :mod:`skmotion.tree._layout`.
+are laid out by :mod:`skmotion.tree._decoder._tables`.
 """
 
 import numpy as np
 
 from libc.math cimport INFINITY, log
 
-from skmotion.tree._beam_candidates cimport _candidates
-from skmotion.tree._beam_memory cimport _allocate, _gaussians, _release
-from skmotion.tree._beam_passes cimport _best, _best_all, _kbest
-from skmotion.tree._beam_structs cimport (
+from skmotion.tree._decoder._beam_candidates cimport _candidates
+from skmotion.tree._decoder._beam_memory cimport _allocate, _gaussians, _release
+from skmotion.tree._decoder._beam_passes cimport _best, _best_all, _kbest
+from skmotion.tree._decoder._beam_structs cimport (
     BEST, KBEST, PRUNE, Decode, Layer, Table, Work, _moves_of, _pick, _same_row, intp,
 )
 
@@ -279,11 +279,11 @@ def decode_searches(const double[:, ::1] frames, const intp[::1] frame_start, co
     problem_start : ndarray of shape (n_searches + 1,)
     score_graph : ndarray of shape (n_problems,)
     gauss : dict
-        The nodes' Gaussians as :func:`skmotion.tree._layout.gaussian_arrays` lays them out.
+        The nodes' Gaussians as :func:`skmotion.tree._decoder._tables.gaussian_arrays` lays them out.
     layers : list
         Entry ``l`` (1 to ``L``; entry 0 is unused) is ``(children, ids,
         search_table, score_table, search_allowed, score_allowed)``, as
-        ``skmotion.tree._decode._layer_specs`` makes it: the children in
+        ``skmotion.tree._decoder._decode._layer_specs`` makes it: the children in
         layer ``l`` of the nodes of ``l - 1``, the layer's tree node ids, the
         two graphs' transition tables, and the allowed-node masks
         ``(n_graphs, K_l)`` of uint8, or ``(0, 0)`` for all nodes.
