@@ -17,7 +17,8 @@ from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor, _clip_svd
 from skmotion.neighbors import IntervalIndexNeighbors, _interval_neighbors, _psi, pairwise_psi
 from skmotion.preprocessing import FillGaps, LowPassFilter, VirtualMarkerTransform
-from skmotion.tree import MotionTreeHMM, _batch
+from skmotion.tree import MotionTreeHMM
+from skmotion.tree._decoder import _batch
 from skmotion.utils import _parallel
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips

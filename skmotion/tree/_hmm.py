@@ -32,7 +32,6 @@ from skmotion.tree._calibration import (
     per_frame,
 )
 from skmotion.tree._decoder import NODE_PRIORS, decode_clips
-from skmotion.tree._gaussian import COVARIANCE_TYPES
 from skmotion.tree._growth import (
     Graphs,
     LiveDatabase,
@@ -42,7 +41,7 @@ from skmotion.tree._growth import (
     union_classes,
 )
 from skmotion.tree._motion_tree import MotionTree
-from skmotion.tree._split import SPLIT_CRITERIA
+from skmotion.tree._params import TREE_CONSTRAINTS, TreeParams
 from skmotion.tree._transitions import count_database_graphs
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._labels import check_clip_labels, check_label_types
@@ -51,6 +50,8 @@ from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 from skmotion.utils._validation import check_int
 
 __all__ = ["MotionTreeHMM"]
+
+_TREE = TreeParams()  # the build's defaults are the tree's measured ones
 
 
 class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
@@ -221,12 +222,7 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
     """
 
     _parameter_constraints = {
-        "max_depth": [Interval(Integral, 0, None, closed="left"), None],
-        "min_samples_split": [Interval(Integral, 2, None, closed="left")],
-        "min_samples_leaf": [Interval(Integral, 1, None, closed="left")],
-        "split": [StrOptions(set(SPLIT_CRITERIA))],
-        "covariance_type": [StrOptions(set(COVARIANCE_TYPES))],
-        "reg_covar": [Interval(Real, 0, None, closed="neither")],
+        **TREE_CONSTRAINTS,
         "graph": [StrOptions({"class", "clip"})],
         "node_prior": [StrOptions(set(NODE_PRIORS))],
         "smoothing": [Interval(Real, 0, None, closed="neither")],
@@ -242,12 +238,12 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
     def __init__(
         self,
         *,
-        max_depth=8,
-        min_samples_split=2,
-        min_samples_leaf=4,
-        split="two_means",
-        covariance_type="diag",
-        reg_covar=1e-6,
+        max_depth=_TREE.max_depth,
+        min_samples_split=_TREE.min_samples_split,
+        min_samples_leaf=_TREE.min_samples_leaf,
+        split=_TREE.split,
+        covariance_type=_TREE.covariance_type,
+        reg_covar=_TREE.reg_covar,
         graph="class",
         node_prior="layer",
         smoothing=1.0,
@@ -316,15 +312,7 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
             self.scale_ = np.where(spread > 0, spread, 1.0)
             frames = (frames - self.center_) / self.scale_
         say(self.verbose, f"MotionTreeHMM: building the tree over {len(frames):,} frames")
-        tree = MotionTree.build(
-            frames,
-            max_depth=self.max_depth,
-            min_samples_split=self.min_samples_split,
-            min_samples_leaf=self.min_samples_leaf,
-            split=self.split,
-            covariance_type=self.covariance_type,
-            reg_covar=self.reg_covar,
-        )
+        tree = MotionTree.from_params(frames, TreeParams.of(self))
         say(self.verbose, f"MotionTreeHMM: {tree.n_layers} layers; counting the transition graphs")
         labels = list(tree.iter_apply(frames))
         self._set_tree(tree)
@@ -971,7 +959,6 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
             # the whole database has grown rebuild_growth times: built again, as fit
             # builds it from all clips so far (standardisation and temperature included)
             return self._build_live(live.clips + clips, live.labels + list(y), classes)
-        params = ("max_depth", "min_samples_split", "min_samples_leaf", "split")
         tree, graphs = grow(
             live,
             Graphs(self.global_graph_, self.graphs_, self.graph_classes_, self.classes_),
@@ -980,7 +967,7 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
             classes,
             per_clip=self.graph == "clip",
             smoothing=self.smoothing,
-            build_params={name: getattr(self, name) for name in params},
+            build_params=TreeParams.of(self),
             growth=growth,
         )
         self._set_tree(tree)

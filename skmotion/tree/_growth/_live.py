@@ -27,6 +27,7 @@ to rounding); the structure does, through the moments at which nodes are
 grown again.
 """
 
+from dataclasses import replace
 from numbers import Real
 
 import numpy as np
@@ -210,6 +211,7 @@ class LiveDatabase:
         return (np.concatenate(clips) - self.center) / self.scale
 
     def add(self, clips, labels, *, split_growth, rebuild_growth, rebuild_tol, build_params):
+        # build_params: a TreeParams, the build's rule for leaves split and subtrees built again
         """Merge new clips; split and rebuild where due (the root excepted: ``root_due``).
 
         Returns whether the tree's structure changed.
@@ -260,10 +262,10 @@ class LiveDatabase:
         if rebuild_growth is not None:
             due[1:] |= split[1:] & (m.count[1:] >= rebuild_growth * self.checked[1:])
         if split_growth is not None:
-            max_depth = params["max_depth"]
+            max_depth = params.max_depth
             room = np.ones(len(split), bool) if max_depth is None else tree.depth < max_depth
             # the build splits every node of min_split frames (when a cut is admissible)
-            min_split = max(params["min_samples_split"], 2 * params["min_samples_leaf"], 2)
+            min_split = max(params.min_samples_split, 2 * params.min_samples_leaf, 2)
             grown = (m.count >= split_growth * self.checked) | (
                 (self.checked < min_split) & (m.count >= min_split)
             )
@@ -289,17 +291,12 @@ class LiveDatabase:
         labels = tree.apply(all_frames, int(tree.depth[node]))
         mine = all_frames[tree.layers[tree.depth[node]][labels] == node]
         self.checked[node] = len(mine)
-        max_depth = params["max_depth"]
-        room = None if max_depth is None else max_depth - int(tree.depth[node])
-        sub = build_nodes(
-            np.ascontiguousarray(mine),
-            max_depth=room,
-            min_samples_split=params["min_samples_split"],
-            min_samples_leaf=params["min_samples_leaf"],
-            split=params["split"],
-            covariance_type=tree.covariance_type,
-            reg_covar=1.0,
+        room = None if params.max_depth is None else params.max_depth - int(tree.depth[node])
+        # the subtree's covariances are replaced by its nodes' merged moments (_graft)
+        params = replace(
+            params, max_depth=room, covariance_type=tree.covariance_type, reg_covar=1.0
         )
+        sub = build_nodes(np.ascontiguousarray(mine), **params.as_dict())
         had_children = tree.left[node] >= 0
         if len(sub["parent"]) == 1 and not had_children:
             return None

@@ -102,7 +102,7 @@ def grow(live, old, clips, y, classes, *, per_clip, smoothing, build_params, gro
         One graph per clip (``graph="clip"``), else one per class.
     smoothing : float
         The graphs' pseudo-transitions.
-    build_params : dict
+    build_params : TreeParams
         The build's rule for leaves split and subtrees built again.
     growth : dict
         ``split_growth``, ``rebuild_growth`` and ``rebuild_tol``.
