@@ -2,7 +2,7 @@
 
 ``fit`` returns self and sets only trailing-underscore attributes, nothing works before
 ``fit``, the input is left alone, pickles, seeds, refits and ``n_jobs`` give identical
-results. Run through :mod:`skmotion.utils.estimator_checks`.
+results. Run through :mod:`skmotion.estimator_checks`.
 """
 
 import copy
@@ -12,7 +12,7 @@ import numpy as np
 from sklearn.base import clone
 from sklearn.exceptions import NotFittedError
 
-from skmotion.utils._conformance_helpers import (
+from skmotion.estimator_checks._helpers import (
     OUTPUT_METHODS,
     _fit,
     _raises,

@@ -1,28 +1,7 @@
-"""Conformance checks for estimators whose samples are motion clips.
+"""The clip conformance checks as one list, run on one estimator or as pytest tests.
 
-sklearn's ``check_estimator`` skips every check for estimators that do not take 2-D
-tables (one sample per row), so this module covers the same ground for clip
-collections: fit returns self; fitted attributes end in ``_``; input is not modified;
-lists, tuples, 3-D arrays and (clip, frame) DataFrames give the same results; pickles
-predict identically; a channel mismatch, an empty collection, NaN and too-short clips
-are rejected with a message naming the clip; the same seed gives the same result and
-``n_jobs`` does not change it; ``set_output(transform="pandas")`` and
-``get_feature_names_out`` agree; ``cross_val_score`` and ``GridSearchCV`` run; plus
-sklearn's own checks that need no data (cloning, ``get_params``/``set_params``, repr).
-
-Run them on one estimator with :func:`check_clip_estimator`, or one pytest test per
-check with :func:`parametrize_with_clip_checks` (as sklearn's
-``parametrize_with_checks``)::
-
-    from skmotion.utils.estimator_checks import ClipCase, parametrize_with_clip_checks
-
-    @parametrize_with_clip_checks([ClipCase(MyEstimator(), make_data)])
-    def test_conformance(check):
-        check()
-
-``make_data`` returns ``(X, y)``: a list of clips (at least 3 clips per class for
-classifiers) and labels, or ``y=None``. pytest is imported only by
-:func:`parametrize_with_clip_checks`; the rest needs only skmotion's own dependencies.
+:class:`ClipCase` (an estimator and its data), ``CHECKS`` (every check, in
+order), :func:`check_clip_estimator` and :func:`parametrize_with_clip_checks`.
 """
 
 from dataclasses import dataclass, field
@@ -30,8 +9,7 @@ from functools import partial
 
 import numpy as np
 
-# The checks live in modules by what they check; they stay importable from here.
-from skmotion.utils._conformance_fitting import (  # noqa: F401
+from skmotion.estimator_checks._fitting import (
     check_deterministic,
     check_fit_idempotent,
     check_fit_returns_self,
@@ -41,28 +19,22 @@ from skmotion.utils._conformance_fitting import (  # noqa: F401
     check_not_fitted,
     check_pickle,
 )
-from skmotion.utils._conformance_helpers import (  # noqa: F401
-    OUTPUT_METHODS,
-    as_dataframe,
-    assert_outputs_equal,
-    equal_length,
+from skmotion.estimator_checks._helpers import (
     motion_tags,
-    outputs,
 )
-from skmotion.utils._conformance_input import (  # noqa: F401
+from skmotion.estimator_checks._input import (
     check_channel_mismatch,
     check_containers_agree,
     check_empty_collection,
     check_nan_rejected,
     check_too_short,
 )
-from skmotion.utils._conformance_sklearn import (  # noqa: F401
+from skmotion.estimator_checks._sklearn import (
     SKLEARN_DATA_FREE_CHECKS,
     check_cross_val_score,
     check_grid_search,
     check_set_output_pandas,
     check_sklearn,
-    scoring_model,
 )
 
 __all__ = [
@@ -154,7 +126,7 @@ def parametrize_with_clip_checks(cases):
     Examples
     --------
     >>> from skmotion.preprocessing import ResampleClips
-    >>> from skmotion.utils.estimator_checks import ClipCase, parametrize_with_clip_checks
+    >>> from skmotion.estimator_checks import ClipCase, parametrize_with_clip_checks
     >>> mark = parametrize_with_clip_checks([ClipCase(ResampleClips(n_frames=8))])
     >>> mark.args[0], len(mark.args[1]) > 20
     ('check', True)
@@ -189,7 +161,7 @@ def make_check_data(estimator, *, n_channels=10, random_state=0):
     Examples
     --------
     >>> from skmotion.preprocessing import ResampleClips
-    >>> from skmotion.utils.estimator_checks import make_check_data
+    >>> from skmotion.estimator_checks import make_check_data
     >>> X, y = make_check_data(ResampleClips(n_frames=8))
     >>> len(X), X[0].shape[1], y[:3].tolist()
     (9, 10, ['a', 'b', 'c'])
@@ -232,7 +204,7 @@ def check_clip_estimator(estimator, data=None, *, param_grid=None, skip=None):
     Examples
     --------
     >>> from skmotion.preprocessing import ResampleClips
-    >>> from skmotion.utils.estimator_checks import check_clip_estimator
+    >>> from skmotion.estimator_checks import check_clip_estimator
     >>> passed = check_clip_estimator(ResampleClips(n_frames=8))
     >>> "ResampleClips-check_pickle" in passed
     True

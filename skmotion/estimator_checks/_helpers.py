@@ -1,8 +1,7 @@
 """What the clip conformance checks share: running an estimator and comparing its results.
 
-Used by the checks of :mod:`skmotion.utils.estimator_checks` (``_conformance_fitting``,
-``_conformance_input``, ``_conformance_sklearn``); the public names are importable
-from there.
+Used by the checks of :mod:`skmotion.estimator_checks` (``_fitting``,
+``_input``, ``_sklearn``); the public names are importable from there.
 """
 
 import re

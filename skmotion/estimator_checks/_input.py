@@ -1,14 +1,14 @@
 """Clip conformance checks of the input: containers, channels, empty, NaN and short clips.
 
 Every container kind gives the same results; bad collections are rejected with a
-``ValueError`` naming what and where. Run through :mod:`skmotion.utils.estimator_checks`.
+``ValueError`` naming what and where. Run through :mod:`skmotion.estimator_checks`.
 """
 
 import numpy as np
 import pandas as pd
 from sklearn.base import clone
 
-from skmotion.utils._conformance_helpers import (
+from skmotion.estimator_checks._helpers import (
     OUTPUT_METHODS,
     _fit,
     _raises,

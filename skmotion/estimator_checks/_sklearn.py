@@ -1,7 +1,7 @@
 """Clip conformance checks of the sklearn integration.
 
 sklearn's own checks that need no data, ``set_output``/``get_feature_names_out``,
-``cross_val_score`` and ``GridSearchCV``. Run through :mod:`skmotion.utils.estimator_checks`.
+``cross_val_score`` and ``GridSearchCV``. Run through :mod:`skmotion.estimator_checks`.
 """
 
 import numpy as np
@@ -11,8 +11,8 @@ from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import GridSearchCV, KFold, cross_val_score
 from sklearn.pipeline import make_pipeline
 
+from skmotion.estimator_checks._helpers import _as_list, _fit, motion_tags
 from skmotion.preprocessing import FlattenClips, ResampleClips
-from skmotion.utils._conformance_helpers import _as_list, _fit, motion_tags
 
 # sklearn's checks that need no data: they cover get_params/set_params/clone.
 SKLEARN_DATA_FREE_CHECKS = (
