@@ -54,7 +54,7 @@ def run(context):
     tree = model.tree_
     clip = clips[test[0]]
     half_second = max(2, int(round(0.5 * data.frame_rate)))
-    states = model.decode([clip[:half_second]])[0]
+    states = model.decode([clip[:half_second]])[1][0]
     ahead = model.predict_next([clip[:half_second]], n_steps=5, n_best=1)
     n_markers = clip.shape[1] // 6
     lines = [

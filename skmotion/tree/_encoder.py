@@ -24,8 +24,8 @@ from skmotion.tree._histograms import (
     second_order_features,
 )
 from skmotion.tree._motion_tree import MotionTree
+from skmotion.tree._params import TREE_CONSTRAINTS
 from skmotion.tree._routing import TreeRouter
-from skmotion.tree._split import SPLIT_CRITERIA
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._features import channel_names_in
 from skmotion.utils._progress import say
@@ -176,8 +176,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
 
     _parameter_constraints = {
         "max_depth": [Interval(Integral, 1, None, closed="left")],
-        "min_samples_leaf": [Interval(Integral, 1, None, closed="left")],
-        "split": [StrOptions(set(SPLIT_CRITERIA))],
+        "min_samples_leaf": TREE_CONSTRAINTS["min_samples_leaf"],
+        "split": TREE_CONSTRAINTS["split"],
         "layers": [StrOptions({"all"}), "array-like"],
         "pyramid": ["array-like"],
         "transition_layers": ["array-like"],
