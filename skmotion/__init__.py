@@ -19,6 +19,7 @@ _SUBPACKAGES = (
     "neighbors",
     "plotting",
     "preprocessing",
+    "recognition",
     "utils",
     "tree",
     "planning",

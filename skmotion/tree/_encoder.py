@@ -50,10 +50,12 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     (0.5: the Hellinger map, which stabilises the variance of small shares),
     and, by default, where its frames sit within the nodes of two layers
     (residuals) and the mean and root mean square of each channel over the
-    clip (moments). A linear classifier on these vectors is the recommended
-    recogniser on multi-subject data::
+    clip (moments). A linear classifier on these vectors recognises motions;
+    :class:`~skmotion.recognition.MotionClassifier` is the measured chain in one
+    estimator (markers scaled by blocks, every layer's occupancy, the means over a
+    temporal pyramid, a logistic regression)::
 
-        make_pipeline(VirtualMarkerTransform(...), MotionTreeEncoder(), LogisticRegression())
+        MotionClassifier(layout="kinect_v2")  # or make_pipeline(..., MotionTreeEncoder(), ...)
 
     Parameters
     ----------

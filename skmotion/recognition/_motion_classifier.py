@@ -1,0 +1,396 @@
+"""MotionClassifier: the recommended recogniser, markers -> tree vocabulary -> linear model."""
+
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.linear_model import LogisticRegression
+from sklearn.preprocessing import StandardScaler
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import check_is_fitted
+
+from skmotion.base import ClipEstimatorMixin, MotionTags
+from skmotion.io import Motion
+from skmotion.kinematics import Skeleton
+from skmotion.kinematics._layouts import Layout
+from skmotion.preprocessing import VirtualMarkerTransform
+from skmotion.tree import MotionTreeEncoder
+from skmotion.tree._calibration import mixture_novelty
+from skmotion.utils._clips import check_clips, stack_clips
+from skmotion.utils._progress import say
+from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
+
+__all__ = ["MotionClassifier", "block_scales"]
+
+
+def block_scales(frames, blocks, weights):
+    """One scale per block of channels: each block's frames to unit spread, times its weight.
+
+    Positions and velocities of markers share units within their block (metres or
+    body heights; per second), so each block is divided by one number, its
+    root-mean-square deviation over all of its channels: a channel that barely
+    moves stays small instead of having its noise blown up to unit variance, as
+    per-channel standardisation would do.
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, n_channels)
+    blocks : ndarray of int of shape (n_channels,)
+        The block of each channel, ``0 .. n_blocks - 1``.
+    weights : sequence of float
+        The weight of each block after scaling.
+
+    Returns
+    -------
+    scale : ndarray of shape (n_channels,)
+        Divide the frames by it; a block with no spread gets scale ``1 / weight``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> frames = np.array([[0.0, 10.0, 1.0], [2.0, -10.0, 1.0]])
+    >>> block_scales(frames, np.array([0, 0, 1]), [1.0, 0.5]).round(3).tolist()
+    [7.106, 7.106, 2.0]
+    """
+    blocks = np.asarray(blocks)
+    deviation = frames - frames.mean(axis=0)
+    scale = np.empty(frames.shape[1])
+    for block, weight in enumerate(weights):
+        columns = blocks == block
+        spread = np.sqrt(np.mean(np.square(deviation[:, columns]))) if columns.any() else 0.0
+        scale[columns] = (spread if spread > 0 else 1.0) / weight
+    return scale
+
+
+class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
+    """Recognise motions in one line: markers, the motion tree's vocabulary, a linear model.
+
+    The chain measured best on multi-subject skeleton data, with its measured
+    defaults (user guide, ``docs/recognition.md``):
+
+    1. **markers** -- with a ``layout`` (joint positions from a tracker) or a
+       ``skeleton`` (joint angles), :class:`~skmotion.preprocessing.VirtualMarkerTransform`
+       puts every clip in the body frame (origin on the floor below the root,
+       facing forward, lengths in body sizes) and appends the markers' velocities;
+       without either, the clips' channels are used as they are;
+    2. **scaling** -- marker positions and velocities are each scaled as one
+       block (one number per block, velocities weighted by ``velocity_weight``);
+       other channels are standardised one by one (their units differ);
+    3. **vocabulary** -- a :class:`~skmotion.tree.MotionTreeEncoder` over the
+       scaled frames: every clip becomes the occupancy of every tree layer over a
+       (1, 2, 3) temporal pyramid, the residuals of two layers, and each
+       channel's mean over the clip, its halves and its quarters (a coarse
+       trajectory) with its root mean square;
+    4. **classifier** -- the columns standardised, then a multinomial logistic
+       regression (``C``), whose probabilities are the answer of
+       :meth:`predict_proba`.
+
+    Parameters
+    ----------
+    layout : str or Layout, default=None
+        The joint layout of position clips (a name from
+        :data:`~skmotion.preprocessing.LAYOUTS`, e.g. ``"kinect_v2"``).
+    skeleton : Skeleton, default=None
+        The skeleton of joint-angle clips. Give a layout or a skeleton, not both;
+        neither for :class:`~skmotion.io.Motion` clips (they carry their own
+        skeleton, and go through the marker step) or for clips whose channels are
+        features already (sensors, or markers computed before), which are used as
+        they are.
+    markers : "auto", str, MarkerSet or list, default="auto"
+        The markers :class:`~skmotion.preprocessing.VirtualMarkerTransform`
+        outputs (its ``markers`` parameter).
+    frame_rate : float, default=None
+        Frames per second of plain-array clips, needed for the markers'
+        velocities (Motions carry their own).
+    scaling : {"auto", "blocks", "channels"}, default="auto"
+        ``"blocks"``: positions and velocities each as one block; ``"channels"``:
+        every channel to zero mean and unit variance; ``"auto"``: blocks after
+        the marker step, channels without it.
+    velocity_weight : float, default=0.5
+        The velocities' block weight against the positions' (``"blocks"`` only).
+    max_depth : int, default=6
+        The motion tree's deepest layer (its vocabulary: up to ``2 ** max_depth``
+        poses).
+    residual_layers : array-like of int, default=(1, 3)
+        The tree layers whose residuals are encoded.
+    moment_pyramid : array-like of int, default=(1, 2, 4)
+        The parts of the clip over which each channel's mean is taken.
+    C : float, default=0.1
+        Inverse regularisation of the logistic regression (on standardised columns).
+    n_jobs : int, default=None
+        Clips turned into markers in parallel (joblib threads).
+    verbose : int, default=0
+        1 or more reports the steps of ``fit`` on standard error.
+
+    Attributes
+    ----------
+    markers_ : VirtualMarkerTransform or None
+        The fitted marker step (None without a layout or skeleton).
+    scale_ : ndarray of shape (n_channels_encoded,)
+        The scaling of the encoder's input channels.
+    center_ : ndarray of shape (n_channels_encoded,)
+        The centre subtracted before scaling (the training frames' mean).
+    encoder_ : MotionTreeEncoder
+        The fitted vocabulary.
+    scaler_ : StandardScaler
+        The standardisation of the encoder's columns.
+    classifier_ : LogisticRegression
+        The linear model.
+    classes_ : ndarray of shape (n_classes,)
+        The class labels.
+    n_features_in_ : int
+        Number of input channels.
+    feature_names_in_ : ndarray of str
+        Input channel names, when fit saw a DataFrame with string columns.
+
+    See Also
+    --------
+    MotionTreeEncoder : the vocabulary alone, for a classifier of one's own.
+    MotionTreeHMM : the generative database (decoding, prediction, streaming).
+
+    Examples
+    --------
+    >>> from skmotion.datasets import make_position_motions
+    >>> from skmotion.recognition import MotionClassifier
+    >>> data = make_position_motions("kinect_v2", n_clips_per_class=4, random_state=0)
+    >>> train = data.groups != 3
+    >>> X = data.clips
+    >>> model = MotionClassifier(layout="kinect_v2", frame_rate=data.frame_rate)
+    >>> model = model.fit([x for x, t in zip(X, train) if t], data.target[train])
+    >>> float(model.score([x for x, t in zip(X, train) if not t], data.target[~train]))
+    1.0
+    """
+
+    _parameter_constraints = {
+        "layout": [str, Layout, None],
+        "skeleton": [Skeleton, None],
+        "markers": "no_validation",  # VirtualMarkerTransform validates it
+        "frame_rate": [Interval(Real, 0, None, closed="neither"), None],
+        "scaling": [StrOptions({"auto", "blocks", "channels"})],
+        "velocity_weight": [Interval(Real, 0, None, closed="neither")],
+        "max_depth": [Interval(Integral, 1, None, closed="left")],
+        "residual_layers": ["array-like"],
+        "moment_pyramid": ["array-like"],
+        "C": [Interval(Real, 0, None, closed="neither")],
+        "n_jobs": [Integral, None],
+        "verbose": ["verbose"],
+    }
+    _motion_tags = MotionTags(output_kind="labels")
+
+    def __init__(
+        self,
+        *,
+        layout=None,
+        skeleton=None,
+        markers="auto",
+        frame_rate=None,
+        scaling="auto",
+        velocity_weight=0.5,
+        max_depth=6,
+        residual_layers=(1, 3),
+        moment_pyramid=(1, 2, 4),
+        C=0.1,
+        n_jobs=None,
+        verbose=0,
+    ):
+        self.layout = layout
+        self.skeleton = skeleton
+        self.markers = markers
+        self.frame_rate = frame_rate
+        self.scaling = scaling
+        self.velocity_weight = velocity_weight
+        self.max_depth = max_depth
+        self.residual_layers = residual_layers
+        self.moment_pyramid = moment_pyramid
+        self.C = C
+        self.n_jobs = n_jobs
+        self.verbose = verbose
+
+    @_fit_context(prefer_skip_nested_validation=False)
+    def fit(self, X, y):
+        """Fit the marker step, the vocabulary and the linear model.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels), or of Motion
+            Training clips (or a 3-D array, or a ``(clip, frame)`` DataFrame).
+        y : array-like of shape (n_clips,)
+            The label of each clip.
+
+        Returns
+        -------
+        self : MotionClassifier
+            The fitted classifier.
+        """
+        if self.layout is not None and self.skeleton is not None:
+            raise ValueError("give a layout (joint positions) or a skeleton (angles), not both.")
+        y = np.asarray(y)
+        check_classification_targets(y)
+        self.markers_ = None
+        motions = not isinstance(X, np.ndarray) and any(isinstance(x, Motion) for x in X)
+        if self.layout is not None or self.skeleton is not None or motions:
+            self.markers_ = VirtualMarkerTransform(
+                skeleton=self.skeleton,
+                layout=self.layout,
+                markers=self.markers,
+                frame_rate=self.frame_rate,
+                n_jobs=self.n_jobs,
+            )
+            say(self.verbose, "MotionClassifier: markers")
+            clips = self.markers_.fit_transform(X)
+            self.n_features_in_ = self.markers_.n_features_in_
+            if hasattr(self.markers_, "feature_names_in_"):
+                self.feature_names_in_ = self.markers_.feature_names_in_
+        else:
+            clips = check_clips(X, estimator=self, reset=True)
+        if len(y) != len(clips):
+            raise ValueError(f"X holds {len(clips)} clips but y holds {len(y)} labels.")
+        frames, _ = stack_clips(clips)
+        self.center_ = frames.mean(axis=0)
+        self.scale_ = self._scales(frames)
+        scaled = self._scaled(clips)
+        say(self.verbose, f"MotionClassifier: the vocabulary over {len(frames):,} frames")
+        self.encoder_ = MotionTreeEncoder(
+            max_depth=self.max_depth,
+            layers="all",
+            residual_layers=self.residual_layers,
+            moment_pyramid=self.moment_pyramid,
+            standardize=False,
+            sparse_output=False,
+        ).fit(scaled)
+        features = self.encoder_.transform(scaled)
+        self.scaler_ = StandardScaler().fit(features)
+        say(self.verbose, f"MotionClassifier: the classifier on {features.shape[1]} columns")
+        self.classifier_ = LogisticRegression(C=self.C, max_iter=1000).fit(
+            self.scaler_.transform(features), y
+        )
+        self.classes_ = self.classifier_.classes_
+        return self
+
+    def _scales(self, frames):
+        scaling = self.scaling
+        if scaling == "auto":
+            scaling = "blocks" if self.markers_ is not None else "channels"
+        if scaling == "channels":
+            spread = frames.std(axis=0)
+            return np.where(spread > 0, spread, 1.0)
+        if self.markers_ is None:
+            raise ValueError(
+                "scaling='blocks' needs the marker step (a layout or a skeleton): its "
+                "positions and velocities are the blocks. Use scaling='channels'."
+            )
+        names = self.markers_.get_feature_names_out()
+        velocity = np.array([name.rsplit("_", 1)[-1].startswith("v") for name in names])
+        return block_scales(frames, velocity.astype(int), [1.0, self.velocity_weight])
+
+    def _scaled(self, clips):
+        return [(clip - self.center_) / self.scale_ for clip in clips]
+
+    def _clips(self, X):
+        """Validated clips in the encoder's units."""
+        check_is_fitted(self)
+        if self.markers_ is not None:
+            clips = self.markers_.transform(X)
+        else:
+            clips = check_clips(X, estimator=self)
+        return self._scaled(clips)
+
+    def transform(self, X):
+        """The standardised vocabulary vector of each clip (the linear model's input).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels), or of Motion
+
+        Returns
+        -------
+        features : ndarray of shape (n_clips, n_features)
+        """
+        clips = self._clips(X)
+        return self.scaler_.transform(self.encoder_.transform(clips))
+
+    def decision_function(self, X):
+        """Per-class scores of each clip (the logistic regression's logits).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels), or of Motion
+
+        Returns
+        -------
+        scores : ndarray of shape (n_clips, n_classes)
+            Or ``(n_clips,)`` for two classes (sklearn's convention).
+        """
+        features = self.transform(X)  # checks that the model is fitted first
+        return self.classifier_.decision_function(features)
+
+    def predict_proba(self, X):
+        """Class probabilities of each clip.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels), or of Motion
+
+        Returns
+        -------
+        proba : ndarray of shape (n_clips, n_classes)
+            Columns in the order of ``classes_``.
+        """
+        features = self.transform(X)  # checks that the model is fitted first
+        return self.classifier_.predict_proba(features)
+
+    def predict_log_proba(self, X):
+        """Log of :meth:`predict_proba`.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels), or of Motion
+
+        Returns
+        -------
+        log_proba : ndarray of shape (n_clips, n_classes)
+        """
+        features = self.transform(X)  # checks that the model is fitted first
+        return self.classifier_.predict_log_proba(features)
+
+    def predict(self, X):
+        """The most probable class of each clip.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels), or of Motion
+
+        Returns
+        -------
+        labels : ndarray of shape (n_clips,)
+        """
+        features = self.transform(X)  # checks that the model is fitted first
+        return self.classifier_.predict(features)
+
+    def novelty_score(self, X):
+        """Mean log density of each clip's frames under the vocabulary's deepest layer.
+
+        The nodes of the tree's bottom layer as a Gaussian mixture (spherical,
+        weighted by their share of the training frames), in the encoder's units:
+        lower is more novel. Threshold it at a low quantile of the training
+        clips' scores to reject clips unlike any seen in training.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels), or of Motion
+
+        Returns
+        -------
+        score : ndarray of shape (n_clips,)
+            Higher for clips like the training data.
+        """
+        frames, offsets = stack_clips(self._clips(X))
+        tree = self.encoder_.tree_
+        layer = tree.n_layers - 1
+        counts = tree.counts(layer).astype(float)
+        return mixture_novelty(tree, layer, frames, offsets, np.log(counts / counts.sum()))
+
+    def __sklearn_tags__(self):
+        tags = super().__sklearn_tags__()
+        tags.classifier_tags.multi_class = True
+        return tags

@@ -1,0 +1,196 @@
+"""MotionClassifier against its steps run by hand, on synthetic and real skeletons."""
+
+import pickle
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from sklearn.base import clone
+from sklearn.linear_model import LogisticRegression
+from sklearn.model_selection import GridSearchCV, GroupKFold
+from sklearn.neighbors import KNeighborsClassifier
+from sklearn.pipeline import make_pipeline
+from sklearn.preprocessing import StandardScaler
+
+from skmotion.datasets import make_motions, make_position_motions
+from skmotion.preprocessing import FlattenClips, ResampleClips, VirtualMarkerTransform
+from skmotion.recognition import MotionClassifier, block_scales
+from skmotion.tree import MotionTreeEncoder
+from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
+
+
+def small_clips():
+    data = make_motions(
+        n_clips_per_class=3, classes=["walk", "jump", "wave"], duration=(1.0, 1.5), random_state=1
+    )
+    return [c[:, 6:] for c in data.clips], data.target_names[data.target]
+
+
+@parametrize_with_clip_checks(
+    [ClipCase(MotionClassifier(max_depth=3, C=1.0), small_clips, param_grid={"C": [0.1, 1.0]})]
+)
+def test_conformance(check):
+    check()
+
+
+@pytest.fixture(scope="module")
+def positions():
+    data = make_position_motions("kinect_v2", n_clips_per_class=6, random_state=0)
+    return data
+
+
+def _split(data, subject=3):
+    test = data.groups == subject
+    clips = data.clips
+    pick = lambda mask: [c for c, m in zip(clips, mask) if m]  # noqa: E731
+    return pick(~test), data.target[~test], pick(test), data.target[test]
+
+
+def test_equals_its_steps_run_by_hand(positions):
+    """The estimator is exactly: markers, block scaling, the encoder, standardised columns, LR."""
+    Xtr, ytr, Xte, _ = _split(positions)
+    rate = positions.frame_rate
+    model = MotionClassifier(layout="kinect_v2", frame_rate=rate, max_depth=4).fit(Xtr, ytr)
+
+    markers = VirtualMarkerTransform(layout="kinect_v2", frame_rate=rate).fit(Xtr)
+    Mtr, Mte = markers.transform(Xtr), markers.transform(Xte)
+    frames = np.vstack(Mtr)
+    velocity = np.array([n.rsplit("_", 1)[1][0] == "v" for n in markers.get_feature_names_out()])
+    # each block's root-mean-square deviation, by hand
+    dev = frames - frames.mean(axis=0)
+    rms_p = np.sqrt(np.mean(dev[:, ~velocity] ** 2))
+    rms_v = np.sqrt(np.mean(dev[:, velocity] ** 2))
+    scale = np.where(velocity, rms_v / 0.5, rms_p)
+    np.testing.assert_allclose(model.scale_, scale)
+    center = frames.mean(axis=0)
+    S = lambda M: [(m - center) / scale for m in M]  # noqa: E731
+    encoder = MotionTreeEncoder(
+        max_depth=4, layers="all", moment_pyramid=(1, 2, 4), standardize=False, sparse_output=False
+    ).fit(S(Mtr))
+    head = make_pipeline(StandardScaler(), LogisticRegression(C=0.1, max_iter=1000))
+    head.fit(encoder.transform(S(Mtr)), ytr)
+    np.testing.assert_allclose(
+        model.predict_proba(Xte), head.predict_proba(encoder.transform(S(Mte))), atol=1e-10
+    )
+
+
+def test_beats_nearest_neighbour_on_a_held_out_subject(positions):
+    """A subject never seen in training: at least as good as 1-NN on resampled markers."""
+    scores, baseline = [], []
+    rate = positions.frame_rate
+    for subject in np.unique(positions.groups):
+        Xtr, ytr, Xte, yte = _split(positions, subject)
+        model = MotionClassifier(layout="kinect_v2", frame_rate=rate).fit(Xtr, ytr)
+        scores.append(model.score(Xte, yte))
+        knn = make_pipeline(
+            VirtualMarkerTransform(layout="kinect_v2", frame_rate=rate),
+            ResampleClips(n_frames=32),
+            FlattenClips(),
+            KNeighborsClassifier(1),
+        ).fit(Xtr, ytr)
+        baseline.append(knn.score(Xte, yte))
+    assert np.mean(scores) >= np.mean(baseline)
+    assert np.mean(scores) >= 0.9
+
+
+def test_probabilities_and_decisions_agree(positions):
+    Xtr, ytr, Xte, _ = _split(positions)
+    model = MotionClassifier(layout="kinect_v2", frame_rate=positions.frame_rate, max_depth=4)
+    model.fit(Xtr, ytr)
+    proba = model.predict_proba(Xte)
+    np.testing.assert_allclose(proba.sum(axis=1), 1.0)
+    assert (model.classes_[proba.argmax(axis=1)] == model.predict(Xte)).all()
+    assert (model.decision_function(Xte).argmax(axis=1) == proba.argmax(axis=1)).all()
+    np.testing.assert_allclose(np.exp(model.predict_log_proba(Xte)), proba)
+
+
+def test_novelty_ranks_foreign_clips_lower(positions):
+    Xtr, ytr, Xte, _ = _split(positions)
+    model = MotionClassifier(layout="kinect_v2", frame_rate=positions.frame_rate, max_depth=4)
+    model.fit(Xtr, ytr)
+    rng = np.random.default_rng(0)
+    # the same clips with joints thrown about: poses no person makes
+    foreign = [c + rng.normal(scale=0.3, size=c.shape) for c in Xte]
+    own, other = model.novelty_score(Xte), model.novelty_score(foreign)
+    assert own.min() > np.median(other)
+
+
+def test_pickle_clone_and_grid_search(positions):
+    Xtr, ytr, Xte, _ = _split(positions)
+    model = MotionClassifier(layout="kinect_v2", frame_rate=positions.frame_rate, max_depth=3)
+    model.fit(Xtr, ytr)
+    again = pickle.loads(pickle.dumps(model))
+    np.testing.assert_array_equal(again.predict_proba(Xte), model.predict_proba(Xte))
+    assert clone(model).get_params() == model.get_params()
+    groups = positions.groups[positions.groups != 3]
+    search = GridSearchCV(model, {"velocity_weight": [0.25, 1.0]}, cv=GroupKFold(3))
+    search.fit(Xtr, ytr, groups=groups)
+    assert set(search.best_params_) == {"velocity_weight"}
+
+
+def test_plain_channels_are_standardised_one_by_one():
+    X, y = small_clips()
+    model = MotionClassifier(max_depth=3).fit(X, y)
+    frames = np.vstack(X)
+    np.testing.assert_allclose(model.scale_, frames.std(axis=0))
+    assert model.markers_ is None
+
+
+@pytest.mark.parametrize(
+    "params, match",
+    [
+        ({"scaling": "blocks"}, "needs the marker step"),
+        ({"layout": "kinect_v2", "skeleton": make_motions(1, random_state=0).skeleton}, "not both"),
+        ({"C": 0.0}, "C"),
+        ({"scaling": "per-channel"}, "scaling"),
+    ],
+)
+def test_bad_parameters_are_named(params, match):
+    X, y = small_clips()
+    with pytest.raises(ValueError, match=match):
+        MotionClassifier(**params).fit(X, y)
+
+
+def test_labels_must_match_the_clips():
+    X, y = small_clips()
+    with pytest.raises(ValueError, match="9 clips but y holds 8"):
+        MotionClassifier(max_depth=2).fit(X, y[:8])
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.integers(2, 40),
+    st.lists(st.integers(0, 2), min_size=2, max_size=8),
+    st.floats(0.1, 5.0),
+)
+def test_block_scales_give_each_block_its_weight(n_frames, blocks, weight):
+    rng = np.random.default_rng(n_frames)
+    blocks = np.asarray(blocks)
+    frames = rng.normal(size=(n_frames, len(blocks))) * rng.uniform(0.1, 10, len(blocks))
+    weights = [1.0, weight, 2.0]
+    scaled = (frames - frames.mean(axis=0)) / block_scales(frames, blocks, weights)
+    for block in np.unique(blocks):
+        rms = np.sqrt(np.mean(scaled[:, blocks == block] ** 2))
+        assert rms == pytest.approx(weights[block])
+    # within a block, channels keep their relative spread (one number per block)
+    for block in np.unique(blocks):
+        cols = np.flatnonzero(blocks == block)
+        ratio = scaled[:, cols].std(axis=0) / frames[:, cols].std(axis=0)
+        np.testing.assert_allclose(ratio, ratio[0])
+
+
+def test_msrc12_cross_subject(shared_data):
+    """Real Kinect gestures, people never seen in training (odd ids train, even test)."""
+    path = shared_data / "msrc12" / "msrc12_sequences.npz"
+    if not path.is_file():
+        pytest.skip(f"{path} not found")
+    from benchmarks._msrc12 import msrc12_repetitions
+
+    data = msrc12_repetitions(path, gestures=(1, 2, 3, 4), max_per_sequence=3)
+    train = data.person % 2 == 1
+    pick = lambda mask: [c for c, m in zip(data.clips, mask) if m]  # noqa: E731
+    model = MotionClassifier(layout="kinect_v1", frame_rate=15).fit(
+        pick(train), data.gesture[train]
+    )
+    assert model.score(pick(~train), data.gesture[~train]) >= 0.9
