@@ -19,6 +19,7 @@ from sklearn.utils import Bunch
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
+from skmotion.tree._build import TREE_CONSTRAINTS, TreeParams
 from skmotion.tree._calibration import (
     class_score_features,
     class_score_names,
@@ -41,7 +42,6 @@ from skmotion.tree._growth import (
     union_classes,
 )
 from skmotion.tree._motion_tree import MotionTree
-from skmotion.tree._params import TREE_CONSTRAINTS, TreeParams
 from skmotion.tree._transitions import count_database_graphs
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._labels import check_clip_labels, check_label_types
