@@ -188,7 +188,9 @@ def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
     # one centred copy, squared in place, the scale applied to the sums: a pass over a batch's
     # frames costs as much as the sums themselves
     centred = np.subtract(frames, center)
-    blocks = [_cell_means(centred, clip, lengths, parts) / np.tile(scale, parts) for parts in pyramid]
+    blocks = [
+        _cell_means(centred, clip, lengths, parts) / np.tile(scale, parts) for parts in pyramid
+    ]
     if order >= 2:
         np.square(centred, out=centred)
         blocks.append(np.sqrt(average @ centred) / scale - 1.0)
