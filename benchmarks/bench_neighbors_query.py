@@ -84,7 +84,7 @@ def traversal_rows(index, features, n):
             "us_per_query": 1e6 * one_numpy / len(singles),
         },
     ]
-    stored = index._tree_features
+    stored = index._stored["tree"]
     for algorithm in ("brute", "kd_tree"):
         nn = NearestNeighbors(n_neighbors=1, algorithm=algorithm).fit(stored)
         seconds, _ = time_call(lambda nn=nn: nn.kneighbors(tree), repeats=3)
@@ -257,7 +257,7 @@ def query_cost_rows(n_stored=10_000, n_queries=1_000):
         spectra = clip_spectra(checked, index.k, method=method)
         return svd_project(projection, *spectra), signatures_from_spectra(*spectra, index.k)
 
-    stored_signatures = index._ranking
+    stored_signatures = index._stored.ranking
     precomputed = NearestNeighbors(n_neighbors=1, metric="precomputed").fit(
         np.zeros((n_stored, n_stored), dtype=np.float32)
     )
@@ -268,7 +268,7 @@ def query_cost_rows(n_stored=10_000, n_queries=1_000):
             distance = 1.0 - psi_from_signatures(*signatures, *stored_signatures)
         return precomputed.kneighbors(distance, return_distance=False)[:, 0]
 
-    features_nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(index._tree_features)
+    features_nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(index._stored["tree"])
     found = index.kneighbors(queries, return_distance=False)[:, 0]
     reference = brute_psi()
     cases = (
@@ -334,7 +334,7 @@ def main():
         print(f"{n} clips: fit {time.perf_counter() - start:.1f} s", flush=True)
         features = index.feature_extractor_.transform(queries)
         rows += traversal_rows(
-            index, np.vstack([index._tree_features, features[:, : index.n_levels]]), n
+            index, np.vstack([index._stored["tree"], features[:, : index.n_levels]]), n
         )
         part = end_to_end_rows(index, db, db_labels, queries, query_labels, n)
         end_rows += part

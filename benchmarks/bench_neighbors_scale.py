@@ -140,15 +140,15 @@ def scale_row(index, n, source, times, agrees, candidates, insert_ms, signatures
 def clip_row(n, clips, labels, queries, extra, extra_labels):
     index, fit_s, fit_cpu = timed_fit(PARAMS, clips[:n], labels[:n])
     ours_us, ours = first_neighbor_us(index, queries)
-    psi_us, reference = cpu_us(brute_psi_1nn(index._ranking, queries, index.k), N_QUERIES)
-    nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(index._tree_features)
+    psi_us, reference = cpu_us(brute_psi_1nn(index._stored.ranking, queries, index.k), N_QUERIES)
+    nn = NearestNeighbors(n_neighbors=1, algorithm="brute").fit(index._stored["tree"])
     extractor = index.feature_extractor_
     knn_us, _ = cpu_us(lambda: nn.kneighbors(extractor.transform(queries)), N_QUERIES)
     candidates = index.candidates(queries)
     insert_ms = insert_cpu_ms(index, extra, extra_labels)
     times = (fit_s, fit_cpu, ours_us, psi_us, knn_us)
     agrees = float(np.mean(ours == reference))
-    signatures_bytes = sum(a.nbytes for a in index._ranking)
+    signatures_bytes = sum(a.nbytes for a in index._stored.ranking)
     return index, scale_row(
         index, n, "clips", times, agrees, candidates, insert_ms, signatures_bytes
     )
@@ -157,15 +157,15 @@ def clip_row(n, clips, labels, queries, extra, extra_labels):
 def feature_row(n, base, psi_us_base, n_base):
     """The index on feature vectors: ``base`` (a fitted clip index) copied with jitter."""
     rng = np.random.default_rng(0)
-    copies = -(-n // len(base._tree_features))
+    copies = -(-n // len(base._stored["tree"]))
     noise = 0.2 * base.radius_
     features = np.concatenate(
         [
-            base._tree_features + (c > 0) * rng.normal(size=base._tree_features.shape) * noise
+            base._stored["tree"] + (c > 0) * rng.normal(size=base._stored["tree"].shape) * noise
             for c in range(copies)
         ]
     )[:n]
-    labels = np.tile(np.arange(len(base._tree_features)), copies)[:n]  # the source clip
+    labels = np.tile(np.arange(len(base._stored["tree"])), copies)[:n]  # the source clip
     queries = (
         features[rng.choice(n, N_QUERIES, replace=False)]
         + rng.normal(size=(N_QUERIES, features.shape[1])) * noise
@@ -180,7 +180,9 @@ def feature_row(n, base, psi_us_base, n_base):
     agrees = float(np.mean(ours == knn))  # here: with brute kNN
     source = "feature vectors (brute psi extrapolated)"
     candidates = index.candidates(queries)  # after the insertions, as the row reports them
-    return scale_row(index, n, source, times, agrees, candidates, insert_ms, index._ranking.nbytes)
+    return scale_row(
+        index, n, source, times, agrees, candidates, insert_ms, index._stored.ranking.nbytes
+    )
 
 
 def sharded_rows(n=10_000, n_queries=N_QUERIES):

@@ -29,13 +29,30 @@ import pickle
 from pathlib import Path
 
 import numpy as np
+import pytest
+
+import skmotion
+from skmotion.base import IncompatibleVersionError, compatible_versions
 
 FIXTURE = Path(__file__).parent / "data" / "pickles_before_issue25.pkl"
+SAVED_BY = "0.1.0"
 
 
 def _load():
-    saved = pickle.loads(FIXTURE.read_bytes())
+    data = FIXTURE.read_bytes()
+    if not compatible_versions(SAVED_BY, skmotion.__version__):
+        # a later minor version refuses these pickles, as designed (and says why)
+        with pytest.raises(IncompatibleVersionError, match=f"saved by skmotion {SAVED_BY}"):
+            pickle.loads(data)
+        pytest.skip(f"skmotion {skmotion.__version__} refuses pickles of {SAVED_BY}, as designed")
+    saved = pickle.loads(data)
     return saved["objects"], saved["answers"], saved["X"]
+
+
+def test_an_incompatible_version_refuses_the_old_pickles(monkeypatch):
+    monkeypatch.setattr(skmotion, "__version__", "0.2.0")
+    with pytest.raises(IncompatibleVersionError, match=f"saved by skmotion {SAVED_BY}"):
+        pickle.loads(FIXTURE.read_bytes())
 
 
 def _assert_same_answers(got, expected):

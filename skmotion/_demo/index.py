@@ -38,7 +38,7 @@ def _repeated_motions(context):
     )
     index.fit(data.clips, labels)
     pruning, found = _search_report(index, labels)
-    tree = index._tree_features
+    tree = index._stored["tree"]
     batched_us = _us_per_query(lambda: index.index_.leaf_of(tree), len(tree), 20)
     one_us = _us_per_query(lambda: [index.index_.leaf_of(row[None]) for row in tree], len(tree), 2)
     start = time.perf_counter()
@@ -88,7 +88,7 @@ def _marker_clips(context):
         ]
     paper = IntervalIndexNeighbors(n_levels=n_levels, epsilon=1.0).fit(clips, labels)
     pruning, found = _search_report(paper, labels)
-    share, name, component = _widest_label(paper._tree_features, labels, base.get("target_names"))
+    share, name, component = _widest_label(paper._stored["tree"], labels, base.get("target_names"))
     tuned = IntervalIndexNeighbors(
         n_levels=n_levels, epsilon=0.8, features=SVDFeatureExtractor(weighting="first_two")
     ).fit(clips, labels)

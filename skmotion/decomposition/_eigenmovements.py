@@ -1,8 +1,11 @@
 """EigenMovementPCA: PCA of segmented movement (eigenmovements).
 
-The estimator and its fit and transform are here; segmenting and resampling
-clips is in ``_eigenmovement_segments`` and rebuilding movement from codes in
-``_eigenmovement_reconstruction`` (mixins it inherits).
+The estimator, whole: segmenting clips (the rules of
+:mod:`skmotion.preprocessing._segment`), fitting the components, coding
+segments, and rebuilding movement from codes. The work on arrays (resampled
+segment vectors, re-timing, assembling clips, the codes' container) is in the
+free functions of ``_segment_vectors``; the components come from
+``_principal_axes``.
 """
 
 import time
@@ -13,20 +16,33 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags, _OutputConfigMixin
-from skmotion.decomposition._eigenmovement_reconstruction import _ReconstructionMixin
-from skmotion.decomposition._eigenmovement_segments import _SegmentingMixin
 from skmotion.decomposition._principal_axes import principal_axes
-from skmotion.decomposition._segment_vectors import SegmentCodes, codes_frame
-from skmotion.utils._clips import check_clips
+from skmotion.decomposition._segment_vectors import (
+    SegmentCodes,
+    assemble_segments,
+    check_magnitude,
+    check_segments,
+    codes_frame,
+    frame_counts,
+    retime_segments,
+    segment_vectors,
+    vectors_to_segments,
+)
+from skmotion.preprocessing._filter import filter_min_frames
+from skmotion.preprocessing._segment import segment_clip
+from skmotion.utils._clips import check_clips, to_container
+from skmotion.utils._parallel import parallel_map
 from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["EigenMovementPCA"]
 
+# Inputs up to this magnitude are handled exactly as at unit scale (they are divided by a
+# power of two inside); beyond it the variances, in squared input units, overflow float64.
+_MAX_MAGNITUDE = 1e150
 
-class EigenMovementPCA(
-    _SegmentingMixin, _ReconstructionMixin, ClipEstimatorMixin, _OutputConfigMixin, BaseEstimator
-):
+
+class EigenMovementPCA(ClipEstimatorMixin, _OutputConfigMixin, BaseEstimator):
     """Eigenmovements: PCA of movement segments, each coded by a few numbers.
 
     Each clip is cut into segments (strokes from rest to rest), each segment is
@@ -347,3 +363,186 @@ class EigenMovementPCA(
                     "channels seen in fit."
                 )
         return np.asarray([f"eigenmovementpca{i}" for i in range(self.n_components_)], dtype=object)
+
+    # -- segments ----------------------------------------------------------------------
+
+    def _min_frames(self):
+        if self.segmentation == "none" or self.filter_order is None:
+            return 1
+        return filter_min_frames(self.filter_order, self.filter_cutoff)
+
+    def _segments_of(self, clip):
+        """Segments of a clip already divided by ``self._scale`` (absolute thresholds too)."""
+        if self.segmentation == "none":
+            return np.array([[0, len(clip)]], dtype=np.intp)
+        scale = self._scale
+        threshold = self.energy_threshold
+        return segment_clip(
+            clip,
+            rule=self.segmentation,
+            frame_rate=self.frame_rate,
+            filter_order=self.filter_order,
+            filter_cutoff=self.filter_cutoff,
+            energy_threshold=None if threshold is None else threshold / scale**2,
+            energy_ratio=self.energy_ratio,
+            zvc_window=self.zvc_window,
+            zvc_min_channels=self.zvc_min_channels,
+            min_movement=self.min_movement / scale,
+        )
+
+    def _normalised(self, clips, reset=False):
+        """The clips divided by a power of two (exact), so that no square overflows.
+
+        ``reset`` chooses the power from the training clips' largest magnitude.
+        """
+        peak = check_magnitude(clips, _MAX_MAGNITUDE, "EigenMovementPCA")
+        if reset:
+            self._scale = float(2.0 ** np.floor(np.log2(peak))) if peak > 0 else 1.0
+        return [c / self._scale for c in clips]
+
+    def _segment_all(self, clips):
+        return parallel_map(self._segments_of, clips, n_jobs=self.n_jobs)
+
+    def _vectors_all(self, clips, segments):
+        return segment_vectors(clips, segments, self.n_samples)
+
+    def segment(self, X):
+        """The segments of each clip, as found by the segmentation rule.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+
+        Returns
+        -------
+        segments : list of ndarray of int of shape (n_segments_i, 2)
+            Per clip, ``(start, stop)`` of each segment (``clip[start:stop]``),
+            in the order of the rows of :meth:`transform`.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        return self._segment_all(self._normalised(clips))
+
+    def segment_vectors(self, X):
+        """The segments of each clip, resampled and flattened (what PCA sees).
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+
+        Returns
+        -------
+        vectors : list of ndarray of shape (n_segments_i, n_channels * n_samples)
+            Per clip, one row per segment, channel after channel.
+        """
+        check_is_fitted(self)
+        normalised = self._normalised(check_clips(X, estimator=self))
+        vectors = self._vectors_all(normalised, self._segment_all(normalised))
+        return [v * self._scale for v in vectors]
+
+    # -- reconstruction ----------------------------------------------------------------
+
+    def _decode(self, codes):
+        return codes @ self.components_ + self.mean_
+
+    def inverse_transform(self, codes, segments=None, n_frames=None):
+        """Movement from codes: time-normalised segments, or clips re-timed.
+
+        Parameters
+        ----------
+        codes : list of ndarray of shape (n_segments_i, n_components_)
+            Per clip, one code per segment (as from :meth:`transform`).
+        segments : list of ndarray of int of shape (n_segments_i, 2), default=None
+            Per clip, ``(start, stop)`` of each segment (as from :meth:`segment`).
+            Without it each segment is returned on the normalised time scale.
+        n_frames : int or sequence of int, default=None
+            With ``segments``: the length of each rebuilt clip (by default the
+            last segment's stop).
+
+        Returns
+        -------
+        movement : list of ndarray
+            Without ``segments``, per clip an array ``(n_segments_i, n_samples,
+            n_channels)``; with them, per clip ``(n_frames_i, n_channels)``: each
+            segment stretched to ``stop - start`` frames by a cubic spline and put
+            in place, the mean of the two at a shared boundary frame, NaN in
+            frames no segment covers.
+        """
+        check_is_fitted(self)
+        codes = check_clips(codes, min_frames=0, input_name="codes")
+        if codes.n_channels != self.n_components_:
+            raise ValueError(
+                f"codes have {codes.n_channels} columns, but this EigenMovementPCA keeps "
+                f"n_components_={self.n_components_}."
+            )
+        normalised = [vectors_to_segments(self._decode(c), self.n_features_in_) for c in codes]
+        if segments is None:
+            if n_frames is not None:
+                raise ValueError("n_frames needs segments: without them, time is normalised.")
+            return normalised
+        segments = check_segments(segments, [len(c) for c in codes])
+        lengths = frame_counts(n_frames, segments)
+        return [self._place(*item) for item in zip(normalised, segments, lengths)]
+
+    def _place(self, normalised, segments, n_frames):
+        pieces = retime_segments(normalised, segments[:, 1] - segments[:, 0])
+        return assemble_segments(pieces, segments, n_frames, self.n_features_in_)
+
+    def _reconstruct(self, clips):
+        normalised = self._normalised(clips)
+        segments = self._segment_all(normalised)
+        rebuilt = []
+        for clip, seg, vectors in zip(clips, segments, self._vectors_all(normalised, segments)):
+            projected = vectors_to_segments(
+                self._decode(self._encode(vectors)), self.n_features_in_
+            )
+            rebuilt.append(self._place(projected, seg, len(clip)))
+        return rebuilt
+
+    def reconstruct(self, X):
+        """Segment, code and rebuild each clip from its eigenmovement codes.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+
+        Returns
+        -------
+        X_rebuilt : list of ndarray of shape (n_frames_i, n_channels)
+            In the container kind of ``X``; frames outside every segment are NaN.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        return to_container(self._reconstruct(clips), clips.container)
+
+    def score(self, X, y=None):
+        """Negative RMS reconstruction error, in the input's units.
+
+        The error is taken over every channel of every frame that some segment
+        covers (see :meth:`reconstruct`), at the clips' real timing.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Clips (or a 3-D array or a (clip, frame) DataFrame).
+        y : None
+            Ignored.
+
+        Returns
+        -------
+        score : float
+            ``-sqrt(mean((x - x_rebuilt) ** 2))``; higher is better.
+        """
+        check_is_fitted(self)
+        clips = check_clips(X, estimator=self)
+        diff = np.concatenate([c - r for c, r in zip(clips, self._reconstruct(clips))])
+        covered = ~np.isnan(diff)
+        if not covered.any():
+            raise ValueError(
+                f"No segments were found in the {len(clips)} clips of X: nothing to score."
+            )
+        scaled = diff[covered] / self._scale  # no square underflows or overflows
+        return -float(np.sqrt(np.mean(scaled**2))) * self._scale

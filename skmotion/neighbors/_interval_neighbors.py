@@ -1,38 +1,52 @@
 """IntervalIndexNeighbors: similarity search over clips with the interval index.
 
-The estimator's public methods are here; reading the input is in
-``_index_input``, building the tree in ``_index_build`` and the stored clips
-in ``_stored_clips`` (mixins it inherits).
+The estimator, whole: reading its input (clips or feature vectors), learning
+the tree's layout and building it (``fit``, ``insert``, ``partial_fit``), and the
+queries. The tree is an :class:`~skmotion.neighbors._interval_index.IntervalIndex`;
+the stored clips and their ranking are a
+:class:`~skmotion.neighbors._stored_clips.StoredClips` it holds; the entry widths
+are learned by the free functions of ``_widths`` and a clip's spectra come from
+``_index_features``.
 """
 
 from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
+from sklearn.utils import check_random_state
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import check_is_fitted, column_or_1d, validate_data
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.decomposition import SVDFeatureExtractor
-from skmotion.neighbors._index_build import _IndexBuildMixin
-from skmotion.neighbors._index_input import _IndexInputMixin
+from skmotion.decomposition._svd_projection import fit_svd_projection, svd_project
+from skmotion.neighbors._index_features import (
+    clip_level_limit,
+    index_spectra,
+    input_kind,
+    resolve_levels,
+)
+from skmotion.neighbors._interval_index import IntervalIndex, entry_edges
+from skmotion.neighbors._psi import signatures_from_spectra
 from skmotion.neighbors._ranking import nearest_in_leaves
-from skmotion.neighbors._stored_clips import _StoredClipsMixin
-from skmotion.neighbors._widths import learn_delta
+from skmotion.neighbors._stored_clips import GrowableStore, StoredClips
+from skmotion.neighbors._widths import learn_delta, radius_for_recall
+from skmotion.utils._clips import check_clips
+from skmotion.utils._labels import check_label_types
+from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["IntervalIndexNeighbors", "learn_delta"]
 
 # Leaves ranked per parallel task: fixed, so results do not depend on n_jobs.
 _LEAVES_PER_TASK = 32
+# Levels of the tree when neither n_levels nor features.n_components is given.
+_DEFAULT_LEVELS = 7
+# The recall the entry widths are learned for when neither rule is given.
+_DEFAULT_RECALL = 0.99
 
 
-class IntervalIndexNeighbors(
-    _IndexInputMixin,
-    _IndexBuildMixin,
-    _StoredClipsMixin,
-    ClipEstimatorMixin,
-    ClassifierMixin,
-    BaseEstimator,
-):
+class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     """Similarity search and k-NN classification of clips through an interval index.
 
     Fit computes each clip's SVD feature vector (the projection of
@@ -267,6 +281,205 @@ class IntervalIndexNeighbors(
         """
         return self._fit(X, y)
 
+    def _fit(self, X, y, classes=None):
+        say(self.verbose, f"{type(self).__name__}: decomposing the clips")
+        tree_features, ranking = self._describe(X, reset=True)
+        y = self._check_labels(y, len(tree_features))
+        if self.input_kind_ == "table":
+            self.projection_ = None
+        self.effective_metric_ = "euclidean" if self.input_kind_ == "table" else "psi"
+        self.classes_ = np.unique(y if classes is None else classes)
+        self._check_known(y)
+        encoded = np.searchsorted(self.classes_, y)
+        say(self.verbose, f"{type(self).__name__}: learning the entry widths")
+        self.index_ = IntervalIndex(*self._layout(tree_features, encoded, ranking))
+        say(self.verbose, f"{type(self).__name__}: building the tree ({self.n_levels_} levels)")
+        self.index_.insert(tree_features)
+        self._stored = StoredClips(self.effective_metric_)
+        self._store(tree_features, ranking, encoded)
+        return self
+
+    def _layout(self, tree_features, encoded, ranking):
+        """Learn ``delta_`` and ``radius_``; return the tree's (edges, radius).
+
+        The layout depends on the training feature vectors and labels only (and
+        on psi signatures for ``similar="psi"``), so a sharded index learns it
+        once and every shard uses it.
+        """
+        self.delta_ = learn_delta(tree_features, encoded, self.delta_quantile)
+        radius = self.radius_ = self._radius(tree_features, encoded, ranking)
+        low, high = tree_features.min(axis=0), tree_features.max(axis=0)
+        edges = [
+            entry_edges(low[i], high[i], self.width_factor * radius[i], self.max_entries)
+            for i in range(len(radius))
+        ]
+        return edges, radius
+
+    def _radius(self, tree_features, encoded, ranking):
+        """Each level's radius by the paper's rule or learned for the recall asked."""
+        if self.epsilon is not None and self.target_recall is not None:
+            raise ValueError(
+                f"epsilon={self.epsilon} and target_recall={self.target_recall}: give one rule "
+                "for the entry widths (epsilon: the paper's epsilon * delta_i; target_recall: "
+                "learned from the similar pairs)."
+            )
+        if self.epsilon is not None:
+            self.width_rule_ = "epsilon"
+            return self.epsilon * self.delta_
+        if self.similar == "psi" and self.effective_metric_ != "psi":
+            raise ValueError('similar="psi" needs clips; X is a table of feature vectors.')
+        self.width_rule_ = "target_recall"
+        radius, self.training_survival_ = radius_for_recall(
+            tree_features,
+            encoded if self.similar == "labels" else ranking,
+            _DEFAULT_RECALL if self.target_recall is None else self.target_recall,
+            check_random_state(self.random_state),
+            max_entries=self.max_entries,
+            width_factor=self.width_factor,
+            n_jobs=self.n_jobs,
+        )
+        return radius
+
+    def insert(self, X, y):
+        """Add clips to the fitted index, without rebuilding it.
+
+        The feature projection, ``delta_`` and the entries stay as fitted.
+
+        Parameters
+        ----------
+        X : clips or feature vectors, as given to :meth:`fit`
+            The clips to add; they get ids ``n_samples_fit_, n_samples_fit_ + 1, ...``.
+        y : array-like of shape (n_clips,)
+            Their labels, from ``classes_``.
+
+        Returns
+        -------
+        self : IntervalIndexNeighbors
+            The index, now holding the new clips.
+        """
+        check_is_fitted(self)
+        tree_features, ranking = self._describe(X, reset=False)
+        y = self._check_labels(y, len(tree_features), known=True)
+        self._check_known(y)
+        encoded = np.searchsorted(self.classes_, y)
+        self.index_.insert(tree_features)
+        self._store(tree_features, ranking, encoded)
+        return self
+
+    def partial_fit(self, X, y, classes=None):
+        """Fit on the first call, then :meth:`insert`.
+
+        Parameters
+        ----------
+        X : clips or feature vectors
+            Clips to index.
+        y : array-like of shape (n_clips,)
+            Their labels.
+        classes : array-like of shape (n_classes,), default=None
+            All the labels later calls may bring; used on the first call only
+            (by default the labels of that call).
+
+        Returns
+        -------
+        self : IntervalIndexNeighbors
+            The index.
+        """
+        if not hasattr(self, "index_"):
+            return self._fit_first(X, y, classes)
+        return self.insert(X, y)
+
+    @_fit_context(prefer_skip_nested_validation=True)
+    def _fit_first(self, X, y, classes):
+        return self._fit(X, y, classes)
+
+    def _store(self, tree_features, ranking, encoded):
+        """Append clips to the stored ones."""
+        self._stored.append_clips(tree_features, ranking, encoded, self.classes_[encoded])
+        self.n_samples_fit_ = len(self._stored)
+        self.labels_ = self._stored["labels"]  # a view: O(1) per insertion
+
+    def __setstate__(self, state):
+        super().__setstate__(state)
+        if type(self._stored) is GrowableStore:  # pickled before StoredClips
+            self._stored = StoredClips.adopt(self._stored)
+
+    # -- input -------------------------------------------------------------------
+
+    def _describe(self, X, *, reset, ranking=True):
+        """Validate ``X`` once; return (feature vectors, ranking data or None).
+
+        Without ranking (candidate sets only) a clip needs only its first
+        singular vector(s), not the ``k`` eigenvectors of psi.
+        """
+        kind = input_kind(X)
+        if reset:
+            self.input_kind_ = kind
+        elif kind != self.input_kind_:
+            expected = "a 2-D array of feature vectors" if self.input_kind_ == "table" else "clips"
+            raise ValueError(
+                f"X: {type(self).__name__} was fitted on {expected}; pass the same kind."
+            )
+        if self.input_kind_ == "table":
+            table = validate_data(self, X, reset=reset, dtype=np.float64)
+            if reset:
+                self.n_levels_ = self._resolve_levels(table.shape[1], "feature(s) of X")
+            return table[:, : self.n_levels_], table
+        clips = check_clips(X, estimator=self, reset=reset)
+        weighting = self._weighting()
+        spectra = index_spectra(clips, weighting, self.k if ranking else 0, n_jobs=self.n_jobs)
+        if reset:
+            self.n_levels_ = self._resolve_levels(*clip_level_limit(clips, weighting))
+            self.projection_ = fit_svd_projection(*spectra, self.n_levels_, weighting)
+        tree = svd_project(self.projection_, *spectra)
+        return tree, signatures_from_spectra(*spectra, self.k) if ranking else None
+
+    def _weighting(self):
+        return "first" if self.features is None else self.features.weighting
+
+    def _resolve_levels(self, limit, what):
+        """``n_levels_``: the levels asked for, or the capped default (see ``n_levels``)."""
+        from_features = None if self.features is None else self.features.n_components
+        return resolve_levels(self.n_levels, from_features, limit, what, _DEFAULT_LEVELS)
+
+    @property
+    def feature_extractor_(self):
+        """A fitted :class:`SVDFeatureExtractor` giving this index's feature vectors."""
+        check_is_fitted(self)
+        if self.input_kind_ == "table":
+            return None
+        return SVDFeatureExtractor.from_projection(
+            self.projection_, self.n_features_in_, n_jobs=self.n_jobs
+        )
+
+    def _check_labels(self, y, n, *, known=False):
+        # Labels that must be among classes_ (known=True) are checked against
+        # them instead: type_of_target costs milliseconds, a clip insertion less.
+        check_label_types(y)
+        if not known:
+            check_classification_targets(y)
+        y = column_or_1d(y, warn=True)
+        if len(y) != n:
+            raise ValueError(f"y has {len(y)} labels, but X has {n} clips.")
+        return y
+
+    def _check_known(self, y):
+        unseen = np.setdiff1d(y, self.classes_)
+        if unseen.size:
+            raise ValueError(
+                f"y: labels {unseen.tolist()} are not among the classes "
+                f"{self.classes_.tolist()}; refit (or pass classes to the first partial_fit) "
+                "to add classes."
+            )
+
+    def _queries(self, X, ranking=True):
+        """(tree features, ranking data, self ids or None) of the queries."""
+        if "index_" not in vars(self):  # fitted: skip check_is_fitted's tags (~10 us a call)
+            check_is_fitted(self)
+        if X is None:
+            return self._stored["tree"], self._stored.ranking, np.arange(self.n_samples_fit_)
+        tree_features, ranking = self._describe(X, reset=False, ranking=ranking)
+        return tree_features, ranking, None
+
     # -- queries -------------------------------------------------------------------
 
     def candidates(self, X=None):
@@ -319,7 +532,9 @@ class IntervalIndexNeighbors(
             )
         distances, indices = nearest_in_leaves(
             self.index_.leaf_of(features),
-            lambda leaf, rows: self._rank_leaf(leaf, rows, ranking, self_ids, n_neighbors),
+            lambda leaf, rows: self._stored.rank_leaf(
+                self.index_.leaf_items(leaf).astype(np.intp), rows, ranking, self_ids, n_neighbors
+            ),
             n_neighbors,
             leaves_per_task=_LEAVES_PER_TASK,
             n_jobs=self.n_jobs,
@@ -341,7 +556,9 @@ class IntervalIndexNeighbors(
         """
         neighbours = self.kneighbors(X, return_distance=False)
         votes = np.zeros((len(neighbours), len(self.classes_)))
-        np.add.at(votes, (np.arange(len(neighbours))[:, None], self._encoded[neighbours]), 1.0)
+        np.add.at(
+            votes, (np.arange(len(neighbours))[:, None], self._stored["encoded"][neighbours]), 1.0
+        )
         return votes / neighbours.shape[1]
 
     def predict(self, X):

@@ -1,15 +1,13 @@
-"""Input kinds and the ranking of candidates, for IntervalIndexNeighbors."""
+"""The ranking of candidates for IntervalIndexNeighbors: psi distances, the k smallest, per leaf."""
 
 import numpy as np
-import pandas as pd
-import scipy.sparse as sp
 
 from skmotion.decomposition._clip_svd import small_blas
 from skmotion.neighbors._psi import psi_from_signatures
 from skmotion.neighbors._psi_rank import psi_distances
 from skmotion.utils._parallel import parallel_map
 
-__all__ = ["input_kind", "nearest_in_leaves", "psi_distance_block", "smallest_k"]
+__all__ = ["nearest_in_leaves", "psi_distance_block", "smallest_k"]
 
 # From this many queries in one leaf, gathering the candidates' signatures and
 # multiplying matrices beats the compiled pair-by-pair loop (measured at 300 and
@@ -31,34 +29,6 @@ def psi_distance_block(query, stored, rows, columns):
         )
     rows, columns = (np.ascontiguousarray(i, dtype=np.intp) for i in (rows, columns))
     return psi_distances(*query, *stored, rows, columns)
-
-
-def input_kind(X):
-    """``"table"`` for a 2-D table of feature vectors, else ``"clips"``.
-
-    Clips are a list or tuple of 2-D arrays, a 3-D array or a ``(clip, frame)``
-    DataFrame; anything else (a 2-D array, a list of 1-D rows, a plain
-    DataFrame) is a table. Objects that are neither go to ``check_clips``, whose
-    TypeError names what was given.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from skmotion.neighbors._ranking import input_kind
-    >>> input_kind(np.zeros((4, 3))), input_kind([np.zeros((5, 3))]), input_kind(None)
-    ('table', 'clips', 'clips')
-    """
-    if isinstance(X, (list, tuple)):
-        # All rows 1-D: a list with one 1-D clip among 2-D ones is a clip collection
-        # with a bad clip, which check_clips names.
-        table = len(X) > 0 and all(np.ndim(x) == 1 for x in X)
-    elif isinstance(X, np.ndarray):
-        table = X.ndim != 3
-    elif isinstance(X, pd.DataFrame):
-        table = not isinstance(X.index, pd.MultiIndex)
-    else:
-        table = sp.issparse(X) or hasattr(X, "__array__")
-    return "table" if table else "clips"
 
 
 def smallest_k(distances, n):

@@ -17,7 +17,7 @@ import numpy as np
 from sklearn.base import clone
 
 from skmotion.decomposition._svd_projection import N_VECTORS, fit_svd_projection, svd_project
-from skmotion.neighbors._describe import clip_level_limit, index_spectra
+from skmotion.neighbors._index_features import clip_level_limit, index_spectra
 from skmotion.neighbors._interval_index import IntervalIndex
 from skmotion.neighbors._interval_neighbors import IntervalIndexNeighbors
 from skmotion.neighbors._psi import signatures_from_spectra

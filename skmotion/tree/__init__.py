@@ -3,6 +3,7 @@
 import sys
 
 from skmotion.tree import _growth, _online
+from skmotion.tree._build import PAPER_SETTINGS
 from skmotion.tree._decoder import (
     NODE_PRIORS,
     beam_decode,
@@ -14,7 +15,6 @@ from skmotion.tree._decoder import (
 from skmotion.tree._encoder import MotionTreeEncoder
 from skmotion.tree._hmm import MotionTreeHMM
 from skmotion.tree._motion_tree import MotionTree
-from skmotion.tree._params import PAPER_SETTINGS
 from skmotion.tree._transitions import TransitionGraphs
 
 # Pickles made before the _growth and _online sub-packages name these modules:

@@ -8,6 +8,7 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
+from skmotion.tree._build import TREE_CONSTRAINTS
 from skmotion.tree._encoder_columns import (
     _existing,
     _int_list,
@@ -24,7 +25,6 @@ from skmotion.tree._histograms import (
     second_order_features,
 )
 from skmotion.tree._motion_tree import MotionTree
-from skmotion.tree._params import TREE_CONSTRAINTS
 from skmotion.tree._routing import TreeRouter
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._features import channel_names_in

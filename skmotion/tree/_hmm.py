@@ -19,6 +19,7 @@ from sklearn.utils import Bunch
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
+from skmotion.tree._build import TREE_CONSTRAINTS, TreeParams
 from skmotion.tree._calibration import (
     class_score_features,
     class_score_names,
@@ -41,7 +42,7 @@ from skmotion.tree._growth import (
     union_classes,
 )
 from skmotion.tree._motion_tree import MotionTree
-from skmotion.tree._params import TREE_CONSTRAINTS, TreeParams
+from skmotion.tree._online import MotionStream, OnlineMotionStream
 from skmotion.tree._transitions import count_database_graphs
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._labels import check_clip_labels, check_label_types
@@ -1065,8 +1066,6 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
         """
         check_is_fitted(self)
         if mode == "online":
-            from skmotion.tree._online._causal import OnlineMotionStream
-
             if window is not None:
                 raise ValueError("window is for mode='exact'; the online stream is causal.")
             return OnlineMotionStream(self, layer=layer, lag=lag, beam=beam, n_best=n_best)
@@ -1074,8 +1073,6 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
             raise ValueError(f"mode must be 'exact' or 'online'; got {mode!r}.")
         if beam is not None:
             raise ValueError("beam is for mode='online'; the exact stream uses n_paths.")
-        from skmotion.tree._online._exact import MotionStream
-
         return MotionStream(self, layer=layer, lag=lag, window=window, n_best=n_best)
 
     def sample(

@@ -10,9 +10,8 @@ from numbers import Integral
 import numpy as np
 
 from skmotion.base import VersionedStateMixin
-from skmotion.tree._build import build_nodes
+from skmotion.tree._build import PAPER_TREE, TreeParams, build_nodes
 from skmotion.tree._gaussian import Gaussians
-from skmotion.tree._params import PAPER_TREE, TreeParams
 
 __all__ = ["MotionTree"]
 
@@ -129,9 +128,9 @@ class MotionTree(VersionedStateMixin):
     ):
         """Build the tree over frames.
 
-        The parameters are those of :class:`~skmotion.tree._params.TreeParams`,
+        The parameters are those of :class:`~skmotion.tree._build._params.TreeParams`,
         which checks them; the defaults are the paper's tree
-        (:data:`~skmotion.tree._params.PAPER_TREE`), where the estimators
+        (:data:`~skmotion.tree._build._params.PAPER_TREE`), where the estimators
         declare their measured ones (the user guide's "Build parameters").
 
         Parameters

@@ -91,7 +91,7 @@ def test_delta_equals_a_loop_over_the_labels(seed, n_labels, quantile):
 
 def _brute_force(index, queries):
     edges, radius = index.index_.edges, index.index_.radius
-    return [brute_force_candidates(edges, radius, index._tree_features, q) for q in queries]
+    return [brute_force_candidates(edges, radius, index._stored["tree"], q) for q in queries]
 
 
 @given(

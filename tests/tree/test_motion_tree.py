@@ -10,8 +10,8 @@ from hypothesis import strategies as st
 
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTree, MotionTreeEncoder, MotionTreeHMM
-from skmotion.tree._params import PAPER_TREE, TREE_CONSTRAINTS, TreeParams
-from skmotion.tree._split import SPLIT_CRITERIA
+from skmotion.tree._build._params import PAPER_TREE, TREE_CONSTRAINTS, TreeParams
+from skmotion.tree._build._split import SPLIT_CRITERIA
 
 
 def blobs(rng, sizes=(120, 80, 60), d=5):

@@ -6,7 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from skmotion.tree._split import SPLIT_CRITERIA, best_split, split_scores
+from skmotion.tree._build._split import SPLIT_CRITERIA, best_split, split_scores
 
 values = arrays(np.float64, st.integers(2, 40), elements=st.floats(-100, 100))
 

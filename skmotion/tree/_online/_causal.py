@@ -45,20 +45,12 @@ import numpy as np
 
 from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decoder._decode import _log_normaliser
+from skmotion.tree._decoder._tables import gaussian_arrays
 from skmotion.tree._online._exact import layer_ancestors, stream_args, update_frames
 from skmotion.tree._online._kernel import OnlineKernel
 from skmotion.utils._validation import check_int
 
 __all__ = ["OnlineMotionStream"]
-
-
-def _gaussian_arrays(tree):
-    """The tree's Gaussians as the compiled decoders read them (one layout for both kernels)."""
-    try:  # where the decoders' layouts are kept since they left MotionTree
-        from skmotion.tree._decoder._tables import gaussian_arrays
-    except ImportError:
-        return tree.kernel_gaussians()
-    return gaussian_arrays(tree)
 
 
 def _transition_table(graph_sets, layer):
@@ -158,7 +150,7 @@ class OnlineMotionStream:
     def _build(self):
         """The model's tables as the kernel reads them, made once per stream."""
         model, tree = self.model, self._tree
-        self._gauss = _gaussian_arrays(tree)
+        self._gauss = gaussian_arrays(tree)  # the batch decoder's layout: one for both kernels
         self._layers, self._norms = [], {}
         for depth in range(1, self._depth + 1):
             scored = depth in self._scored

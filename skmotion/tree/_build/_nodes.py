@@ -14,7 +14,7 @@ from scipy.linalg import eigh
 from scipy.linalg.lapack import dsyevr
 
 from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
-from skmotion.tree._split import best_split
+from skmotion.tree._build._split import best_split
 
 __all__ = ["build_nodes"]
 

@@ -81,7 +81,7 @@ def split_scores(sorted_values, criterion, *, var_floor=0.0):
     Examples
     --------
     >>> import numpy as np
-    >>> from skmotion.tree._split import split_scores
+    >>> from skmotion.tree._build._split import split_scores
     >>> values = np.array([0.0, 0.1, 0.2, 5.0, 5.1, 5.2])
     >>> int(np.argmin(split_scores(values, "two_means"))) + 1
     3
@@ -121,7 +121,7 @@ def best_split(sorted_values, criterion, *, min_samples_leaf=1, tol=0.0):
     Examples
     --------
     >>> import numpy as np
-    >>> from skmotion.tree._split import best_split
+    >>> from skmotion.tree._build._split import best_split
     >>> values = np.r_[np.zeros(5), np.linspace(3, 3.5, 20)]
     >>> best_split(values, "min_error", min_samples_leaf=2)
     5

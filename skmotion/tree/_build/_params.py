@@ -14,7 +14,7 @@ from dataclasses import asdict, dataclass, fields
 from numbers import Integral, Real
 
 from skmotion.tree._gaussian import COVARIANCE_TYPES
-from skmotion.tree._split import SPLIT_CRITERIA
+from skmotion.tree._build._split import SPLIT_CRITERIA
 from skmotion.utils._sklearn_compat import Interval, StrOptions
 from skmotion.utils._validation import check_int
 
@@ -45,7 +45,7 @@ class TreeParams:
         A split is only made when both sides keep this many frames.
     split : {"two_means", "median", "min_error"}, default="two_means"
         How a node's projections on its first principal axis are cut
-        (:data:`~skmotion.tree._split.SPLIT_RULES`).
+        (:data:`~skmotion.tree._build._split.SPLIT_RULES`).
     covariance_type : {"diag", "full", "spherical"}, default="diag"
         The covariance estimator of each node.
     reg_covar : float, default=1e-6
@@ -53,7 +53,7 @@ class TreeParams:
 
     Examples
     --------
-    >>> from skmotion.tree._params import PAPER_TREE, TreeParams
+    >>> from skmotion.tree._build._params import PAPER_TREE, TreeParams
     >>> TreeParams(split="median").split, PAPER_TREE.max_depth
     ('median', None)
     >>> TreeParams(min_samples_leaf=0)  # doctest: +ELLIPSIS

@@ -1,9 +1,46 @@
-"""What the interval index knows of a clip: its spectra, and how many levels the data allows."""
+"""What the interval index reads of its input: clips or a table, their spectra, how many levels.
+
+:func:`input_kind` (clips or feature vectors), :func:`index_spectra` (the
+singular vectors and values the features and psi need), and the number of
+levels the data allows (:func:`clip_level_limit`, :func:`resolve_levels`).
+"""
+
+import numpy as np
+import pandas as pd
+import scipy.sparse as sp
 
 from skmotion.decomposition._clip_svd import clip_spectra
 from skmotion.decomposition._svd_projection import N_VECTORS, max_svd_components
 
-__all__ = ["clip_level_limit", "index_spectra", "resolve_levels"]
+__all__ = ["clip_level_limit", "index_spectra", "input_kind", "resolve_levels"]
+
+
+def input_kind(X):
+    """``"table"`` for a 2-D table of feature vectors, else ``"clips"``.
+
+    Clips are a list or tuple of 2-D arrays, a 3-D array or a ``(clip, frame)``
+    DataFrame; anything else (a 2-D array, a list of 1-D rows, a plain
+    DataFrame) is a table. Objects that are neither go to ``check_clips``, whose
+    TypeError names what was given.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.neighbors._index_features import input_kind
+    >>> input_kind(np.zeros((4, 3))), input_kind([np.zeros((5, 3))]), input_kind(None)
+    ('table', 'clips', 'clips')
+    """
+    if isinstance(X, (list, tuple)):
+        # All rows 1-D: a list with one 1-D clip among 2-D ones is a clip collection
+        # with a bad clip, which check_clips names.
+        table = len(X) > 0 and all(np.ndim(x) == 1 for x in X)
+    elif isinstance(X, np.ndarray):
+        table = X.ndim != 3
+    elif isinstance(X, pd.DataFrame):
+        table = not isinstance(X.index, pd.MultiIndex)
+    else:
+        table = sp.issparse(X) or hasattr(X, "__array__")
+    return "table" if table else "clips"
 
 
 def index_spectra(clips, weighting, k, *, n_jobs=None):
@@ -35,7 +72,7 @@ def resolve_levels(n_levels, from_features, limit, what, default):
 
     Examples
     --------
-    >>> from skmotion.neighbors._describe import resolve_levels
+    >>> from skmotion.neighbors._index_features import resolve_levels
     >>> resolve_levels(None, None, 6, "components", 7), resolve_levels(None, 3, 6, "c", 7)
     (6, 3)
     """
