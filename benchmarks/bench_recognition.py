@@ -55,8 +55,8 @@ from skmotion.tree import MotionTreeEncoder, MotionTreeHMM  # noqa: E402
 
 PEER_FRAMES = 32
 STUDY = {  # candidate -> MotionClassifier parameters (the defaults are the first)
-    "defaults (depth 6, residuals 1 3, means 1 2 4, C 0.01)": {},
-    "C 0.1": {"C": 0.1},
+    "defaults (depth 6, residuals 1 3, means 1 2 4, C 0.1)": {},
+    "C 0.01": {"C": 0.01},
     "C 0.001": {"C": 0.001},
     "no moment pyramid (means over the whole clip)": {"moment_pyramid": (1,)},
     "means 1 2 4 8": {"moment_pyramid": (1, 2, 4, 8)},
