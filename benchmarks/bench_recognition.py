@@ -55,7 +55,7 @@ from skmotion.tree import MotionTreeEncoder, MotionTreeHMM  # noqa: E402
 
 PEER_FRAMES = 32
 STUDY = {  # candidate -> MotionClassifier parameters (the defaults are the first)
-    "defaults (depth 6, residuals 1 3, means 1 2 4, C 0.1)": {},
+    "defaults (depth 6, residuals 1 3, means 1 2 4, C 0.1, velocity weight 1)": {},
     "C 0.01": {"C": 0.01},
     "C 0.001": {"C": 0.001},
     "no moment pyramid (means over the whole clip)": {"moment_pyramid": (1,)},
@@ -63,10 +63,10 @@ STUDY = {  # candidate -> MotionClassifier parameters (the defaults are the firs
     "depth 4": {"max_depth": 4},
     "depth 8": {"max_depth": 8},
     "velocity weight 0.25": {"velocity_weight": 0.25},
-    "velocity weight 1": {"velocity_weight": 1.0},
+    "velocity weight 0.5": {"velocity_weight": 0.5},
     "per-channel standardisation": {"scaling": "channels"},
 }
-CV_GRID = [{"C": c, "velocity_weight": w} for c in (0.003, 0.01, 0.03) for w in (0.5, 1.0)]
+CV_GRID = [{"C": c, "velocity_weight": w} for c in (0.03, 0.1, 0.3) for w in (0.5, 1.0)]
 
 
 # -- the sets: (Xtr, ytr, Xte, yte, groups of the training clips, MotionClassifier kwargs) ------

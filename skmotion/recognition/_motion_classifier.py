@@ -106,7 +106,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         ``"blocks"``: positions and velocities each as one block; ``"channels"``:
         every channel to zero mean and unit variance; ``"auto"``: blocks after
         the marker step, channels without it.
-    velocity_weight : float, default=0.5
+    velocity_weight : float, default=1.0
         The velocities' block weight against the positions' (``"blocks"`` only).
     max_depth : int, default=6
         The motion tree's deepest layer (its vocabulary: up to ``2 ** max_depth``
@@ -185,7 +185,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         markers="auto",
         frame_rate=None,
         scaling="auto",
-        velocity_weight=0.5,
+        velocity_weight=1.0,
         max_depth=6,
         residual_layers=(1, 3),
         moment_pyramid=(1, 2, 4),

@@ -61,7 +61,7 @@ def test_equals_its_steps_run_by_hand(positions):
     dev = frames - frames.mean(axis=0)
     rms_p = np.sqrt(np.mean(dev[:, ~velocity] ** 2))
     rms_v = np.sqrt(np.mean(dev[:, velocity] ** 2))
-    scale = np.where(velocity, rms_v / 0.5, rms_p)
+    scale = np.where(velocity, rms_v, rms_p)
     np.testing.assert_allclose(model.scale_, scale)
     center = frames.mean(axis=0)
     S = lambda M: [(m - center) / scale for m in M]  # noqa: E731
