@@ -128,7 +128,7 @@ def build_parser():
     demo.add_argument("--no-out", action="store_true", help="print the report only; write no files")
     demo.add_argument("--quiet", action="store_true", help="no progress lines on standard error")
     demo.set_defaults(func=_demo)
-    from skmotion.io._info import formats_help
+    from skmotion.io._formats import formats_help
 
     info = commands.add_parser(
         "info",

@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from skmotion.io._formats import FORMATS, file_format
+from skmotion.io._formats import file_format, formats_help
 
-__all__ = ["describe_file"]
+__all__ = ["describe_file", "formats_help"]
 
 
 def _skeleton_lines(skeleton, skeleton_notes):
@@ -147,23 +147,3 @@ def describe_file(path, *, asf=None, frame_rate=None, skeleton_notes=None):
         f"channels: {motion.n_channels}: {_shown(motion.channel_names)}",
         _frames_line(motion),
     ]
-
-
-def formats_help():
-    """One line per format of :data:`FORMATS`, for help texts.
-
-    Returns
-    -------
-    text : str
-
-    Examples
-    --------
-    >>> from skmotion.io._info import formats_help
-    >>> print(formats_help().splitlines()[0])
-    .bvh  BVH: skeleton and joint angles
-    """
-    return "\n".join(
-        f"{row.suffix:<5} {row.name}: {row.description}"
-        + (f" (extra '{row.extra}')" if row.extra else "")
-        for row in FORMATS
-    )

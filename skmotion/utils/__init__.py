@@ -1,15 +1,22 @@
 """Utilities: the clip validator, container conversion, frame stacking, parallelism, progress."""
 
-from skmotion.utils._clips import (
-    Clips,
-    Container,
-    check_clips,
-    split_frames,
-    stack_clips,
-    to_container,
+from skmotion._lazy import attach
+
+__getattr__, __dir__ = attach(
+    __name__,
+    {
+        "skmotion.utils._clips": [
+            "Clips",
+            "Container",
+            "check_clips",
+            "split_frames",
+            "stack_clips",
+            "to_container",
+        ],
+        "skmotion.utils._parallel": ["parallel_map"],
+        "skmotion.utils._progress": ["progress", "say"],
+    },
 )
-from skmotion.utils._parallel import parallel_map
-from skmotion.utils._progress import progress, say
 
 __all__ = [
     "Clips",
