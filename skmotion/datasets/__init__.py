@@ -13,11 +13,13 @@ __getattr__, __dir__ = attach(
         "skmotion.datasets._fetch": ["fetch_cmu_mocap"],
         "skmotion.datasets._home": ["get_data_home"],
         "skmotion.datasets._humanoid": ["humanoid_skeleton"],
+        "skmotion.datasets._labels": ["read_labels"],
         "skmotion.datasets._motion_files": [
             "load_bvh_folder",
             "load_cmu_asfamc",
             "load_motion_folder",
             "read_cmu_index",
+            "read_labels",
         ],
         "skmotion.datasets._positions": [
             "EXTRA_LANDMARKS",
@@ -53,4 +55,5 @@ __all__ = [
     "make_walks",
     "motion_class_of_name",
     "read_cmu_index",
+    "read_labels",
 ]

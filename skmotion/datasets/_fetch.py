@@ -289,7 +289,7 @@ def _select(data, rows):
     """The Bunch restricted to some clips."""
     picked = {}
     for key, value in data.items():
-        if isinstance(value, list):
+        if isinstance(value, list) and key != "skipped":  # skipped: files, not clips
             picked[key] = [value[i] for i in rows]
         elif isinstance(value, np.ndarray) and key not in ("target_names", "subject_names"):
             picked[key] = value[rows]

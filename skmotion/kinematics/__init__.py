@@ -7,6 +7,7 @@ __getattr__, __dir__ = attach(
     {
         "skmotion.kinematics._body_size": ["body_size"],
         "skmotion.kinematics._forward": ["FKResult", "forward_kinematics"],
+        "skmotion.kinematics._layout_check": ["check_layout"],
         "skmotion.kinematics._layouts": ["Layout"],
         "skmotion.kinematics._marker_names": ["MARKER_NAMES"],
         "skmotion.kinematics._named_layouts": ["LAYOUTS", "get_layout"],
@@ -28,6 +29,7 @@ __all__ = [
     "MARKER_NAMES",
     "Skeleton",
     "body_size",
+    "check_layout",
     "check_rotation_order",
     "euler_to_matrix",
     "forward_kinematics",
