@@ -30,7 +30,7 @@ from skmotion.datasets import (
     read_labels,
 )
 from skmotion.datasets._labels import match_labels, subject_confound, subject_level
-from skmotion.io import file_format
+from skmotion.io import file_format, folder_suffixes, read_ts
 from skmotion.kinematics import LAYOUTS, get_layout
 from skmotion.preprocessing import FlattenClips, ResampleClips, resample_clip, to_markers
 
@@ -198,7 +198,84 @@ def _figure_lines(context, motions, filenames, labels):
     return body_figures(context, motion.channels, body, motion.frame_rate, what)
 
 
+def _series_folder(folder):
+    """The ``.ts`` files under ``folder`` when it holds no motion file, else None."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return None
+    files = sorted(p for p in folder.rglob("*") if p.is_file())
+    motion = set(folder_suffixes())
+    if any(p.suffix.lower() in motion for p in files):
+        return None
+    return [p for p in files if p.suffix.lower() == ".ts"] or None
+
+
+def _run_series(context, files):
+    """The demo's data from UEA/sktime ``.ts`` files: labelled series, no body, no subjects."""
+    clips, labels, sources = [], [], []
+    for path in files:
+        try:
+            series, named = read_ts(path)
+        except (OSError, ValueError) as exc:
+            raise DemoDataError(" ".join(str(exc).split())) from None
+        if named is None:
+            raise DemoDataError(f"{path}: the series have no class labels (@classLabel false)")
+        clips += [np.asarray(c, dtype=float) for c in series]
+        labels += [str(v) for v in named]
+        sources += [path.name] * len(series)
+    widths = {}
+    for clip, source in zip(clips, sources):
+        widths.setdefault(clip.shape[1], source)
+    if len(widths) > 1:
+        raise DemoDataError(
+            f"{context.data_folder}: the .ts files hold series of different dimensions ("
+            + ", ".join(f"{w} in {name}" for w, name in widths.items())
+            + "): give a folder of one data set"
+        )
+    target_names, target = np.unique(np.asarray(labels, dtype=object), return_inverse=True)
+    # .ts files record no performer: one unknown subject, so no subject-wise split is claimed.
+    groups = np.zeros(len(clips), dtype=int)
+    subject_names = np.asarray(["(unknown)"], dtype=object)
+    context.data = Bunch(
+        clips=clips, target=target, target_names=target_names, groups=groups,
+        subject_names=subject_names, frame_rate=float(getattr(context, "frame_rate", 30.0)),
+        motions=None, skeletons=[None] * len(clips), skeleton=None, layout=None, kind="series",
+        feature_names=[f"dim_{k}" for k in range(clips[0].shape[1])],
+        filenames=np.asarray(sources, dtype=object), label_sources=["file"] * len(clips),
+        DESCR=f"Labelled time series of {', '.join(p.name for p in files)}.",
+    )  # fmt: skip
+    evaluation = choose_evaluation(
+        target_names[target], groups, subject_names, random_state=context.random_state
+    )
+    context.evaluation = evaluation
+    lengths = np.array([len(c) for c in clips])
+    lines = [
+        f"{context.data_folder}: {len(clips)} labelled series in {len(files)} .ts files "
+        f"({', '.join(p.name for p in files)}), the files' train/test split pooled",
+        f"channels: {clips[0].shape[1]} dimensions (time series: no body, so the body figures, "
+        "virtual markers and planning are not run); length "
+        f"min {lengths.min()}, median {int(np.median(lengths))}, max {lengths.max()} frames",
+        "classes ("
+        + f"{len(target_names)}): "
+        + ", ".join(f"{n} {c}" for n, c in zip(target_names, np.bincount(target))),
+        "subjects: not recorded in .ts files",
+        f"evaluation: {evaluation.reason}",
+    ]
+    if evaluation.kind is None:
+        return lines
+    baseline = make_pipeline(ResampleClips(n_frames=32), FlattenClips(), KNeighborsClassifier(1))
+    scores = evaluation.scores(baseline, clips, target, verbose=context.verbose)
+    context.baseline_accuracy = scores.mean()
+    return lines + [
+        f"baseline, 1-NN on resampled clips, {evaluation.name}: "
+        f"accuracy {scores.mean():.3f} +/- {scores.std():.3f}"
+    ]
+
+
 def run(context):
+    series = _series_folder(context.data_folder)
+    if series is not None and getattr(context, "layout", None) is None:
+        return _run_series(context, series)
     rate = float(getattr(context, "frame_rate", None) or 30.0)
     verbose = getattr(context, "verbose", 0)
     index_path = getattr(context, "index", None) or find_cmu_index(context.data_folder)
