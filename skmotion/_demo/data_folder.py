@@ -198,6 +198,21 @@ def _figure_lines(context, motions, filenames, labels):
     return body_figures(context, motion.channels, body, motion.frame_rate, what)
 
 
+def _keep_skeleton_motions(data):
+    """Leave out position files among skeleton files (no shared features), saying which."""
+    kept = [k for k, m in enumerate(data.motions) if m.skeleton is not None]
+    if not 0 < len(kept) < len(data.motions):
+        return []
+    left = [Path(f).name for k, f in enumerate(data.filenames) if k not in set(kept)]
+    data.motions = [data.motions[k] for k in kept]
+    data.skeletons = [data.skeletons[k] for k in kept]
+    data.filenames = data.filenames[kept]
+    return [
+        f"left out {len(left)} files of marker or joint positions among the skeleton files (the "
+        f"skeletons' virtual markers and the files' markers share no features): {', '.join(left)}"
+    ]
+
+
 def _series_folder(folder):
     """The ``.ts`` files under ``folder`` when it holds no motion file, else None."""
     folder = Path(folder)
@@ -285,6 +300,7 @@ def run(context):
     except (OSError, ValueError) as exc:
         raise DemoDataError(f"--labels {labels_path}: {exc}") from None
     data, notes = _load(context.data_folder, index_path, verbose, labels_path, layout, rate)
+    notes += _keep_skeleton_motions(data)
     index = read_cmu_index(index_path) if index_path else None
     root = Path(context.data_folder).resolve()
     files = [Path(f).resolve() for f in data.filenames]

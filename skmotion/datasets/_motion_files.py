@@ -315,7 +315,7 @@ _BUNCH_DOC = """
             The files that could not be read, and why."""
 
 
-def load_cmu_asfamc(folder, index=None, *, subjects=None, verbose=0):
+def load_cmu_asfamc(folder, index=None, *, subjects=None, errors="skip", verbose=0):
     """Load CMU-style Acclaim data: one folder per subject with ``NN.asf`` and ``NN_TT.amc``.
 
     Parameters
@@ -328,6 +328,8 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None, verbose=0):
         rates; without it every trial is taken at 120 Hz.
     subjects : list of int, default=None
         Only these subjects.
+    errors : {"skip", "raise"}, default="skip"
+        Skip a file that cannot be read (with a warning naming it), or raise.
     verbose : int, default=0
         Report progress over the files on standard error when >= 1.
 
@@ -353,7 +355,7 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None, verbose=0):
             files += _find_files(sub, (".amc",))
     if not files:
         raise FileNotFoundError(f"No .amc trials under {folder} (expected one folder per subject).")
-    entries, skipped = _read_files(files, index, {}, verbose)
+    entries, skipped = _read_files(files, index, {}, verbose, errors)
     _report_skipped(entries, skipped, folder)
     descr = "CMU Graphics Lab Motion Capture Database, Acclaim ASF/AMC."
     return _bunch(entries, folder, index, descr, skipped=skipped)
