@@ -29,13 +29,19 @@ def _edges(graphs, layer, graph, min_probability):
 def _robust_view(xy):
     """Axis limits around the bulk of the nodes; an outlying node would squash the rest.
 
-    The view spans the 2nd to 98th percentile of the nodes on each axis, widened by
-    half that span; nodes outside are drawn on its edge (as triangles) and counted.
+    On an axis where the nodes' range is over three times the span of Tukey's
+    far-out fences (the quartiles widened by three interquartile ranges), the
+    view is the fences; nodes beyond are drawn on its edge (as triangles) and
+    counted. Elsewhere the view holds every node.
     """
-    bulk_low, bulk_high = np.percentile(xy, [2, 98], axis=0)
-    span = np.maximum(bulk_high - bulk_low, 1e-12)
-    low = np.maximum(xy.min(axis=0), bulk_low - 0.5 * span)
-    high = np.minimum(xy.max(axis=0), bulk_high + 0.5 * span)
+    q1, q3 = np.percentile(xy, [25, 75], axis=0)
+    iqr = np.maximum(q3 - q1, 1e-12)
+    low, high = xy.min(axis=0), xy.max(axis=0)
+    fence_low = np.maximum(low, q1 - 3 * iqr)
+    fence_high = np.minimum(high, q3 + 3 * iqr)
+    squashed = (high - low) > 3 * (fence_high - fence_low)
+    low = np.where(squashed, fence_low, low)
+    high = np.where(squashed, fence_high, high)
     outside = ((xy < low) | (xy > high)).any(axis=1)
     return low, high, outside
 
@@ -121,7 +127,7 @@ def plot_motion_tree_layer(
     ...                             frames=frames, labels=labels)
     >>> len(ax.collections[0].get_offsets()) == int(model.n_nodes_[3])
     True
-    >>> sorted(t.get_text() for t in ax.get_legend().get_texts())[:2]
+    >>> [t.get_text() for t in ax.get_legend().get_texts()][2:4]
     ['jump', 'walk']
     """
     plt = _pyplot()
@@ -147,14 +153,17 @@ def plot_motion_tree_layer(
     sizes = 20 + 200 * counts / counts.max()
     from matplotlib.lines import Line2D
 
-    handles = []
+    handles = [
+        Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=4, label="node, small: few frames"),
+        Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=11, label="node, large: many"),
+    ]
     if frames is not None and labels is not None:
         names, majority, share, seen = _node_classes(tree, layer, frames, labels)
         palette = plt.get_cmap("tab10" if len(names) <= 10 else "tab20")
         colours = np.array([palette(k % palette.N) for k in majority])
         colours[:, 3] = np.where(seen, 0.35 + 0.65 * share, 0.15)  # paler: mixed nodes
         style = {"c": colours}
-        handles = [
+        handles += [
             Line2D([], [], marker="o", ls="", mfc=palette(k % palette.N), mec="k", ms=6,
                    label=str(name))
             for k, name in enumerate(names)
@@ -187,10 +196,6 @@ def plot_motion_tree_layer(
         ax.figure.colorbar(
             nodes, ax=ax, label="node spread (largest std)" + (", log" if style["norm"] else "")
         )
-    handles += [
-        Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=4, label="few frames"),
-        Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=11, label="many frames"),
-    ]
     if graphs is not None:
         handles.append(
             Line2D([], [], color="0.45", lw=0.8, label=f"transition, p >= {min_probability:g}")
@@ -257,6 +262,8 @@ def plot_motion_tree_layers(
             tree, graphs, layer, graph=graph, axes=axes, min_probability=min_probability,
             frames=frames, labels=labels, ax=ax,
         )  # fmt: skip
+    for ax in panels[0][:-1]:
+        ax.get_legend().remove()  # one legend, beside the last panel, serves them all
     fig.tight_layout()
     return fig
 
