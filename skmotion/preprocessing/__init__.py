@@ -29,6 +29,7 @@ __getattr__, __dir__ = attach(
         ],
         "skmotion.preprocessing._to_markers": ["to_markers"],
         "skmotion.preprocessing._virtual_markers": ["SIZE_CHAIN", "VirtualMarkerTransform"],
+        "skmotion.preprocessing._to_aeon": ["ToAeon"],
     },
 )
 
@@ -45,6 +46,7 @@ __all__ = [
     "ResampleClips",
     "SEGMENTATION_RULES",
     "SIZE_CHAIN",
+    "ToAeon",
     "VirtualMarkerTransform",
     "body_frame_features",
     "body_size",

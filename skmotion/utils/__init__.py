@@ -15,6 +15,7 @@ __getattr__, __dir__ = attach(
         ],
         "skmotion.utils._parallel": ["parallel_map"],
         "skmotion.utils._progress": ["progress", "say"],
+        "skmotion.utils._bridges": ["from_aeon", "from_tslearn", "to_aeon", "to_tslearn"],
     },
 )
 
@@ -22,10 +23,14 @@ __all__ = [
     "Clips",
     "Container",
     "check_clips",
+    "from_aeon",
+    "from_tslearn",
     "parallel_map",
     "progress",
     "say",
     "split_frames",
     "stack_clips",
+    "to_aeon",
     "to_container",
+    "to_tslearn",
 ]
