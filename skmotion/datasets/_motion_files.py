@@ -296,6 +296,7 @@ _BUNCH_DOC = """
             Label index per clip: the CMU description up to its first comma
             or dash when the index knows the trial, else the clip's subfolder.
         target_names : ndarray of str
+            The distinct labels, sorted.
         groups : ndarray of int
             Subject per clip (the ``NN`` of a CMU ``NN_TT`` file name, else the
             subfolder), for ``GroupKFold``; names in ``subject_names``.
