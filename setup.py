@@ -8,18 +8,21 @@ from Cython.Build import cythonize
 from setuptools import Extension, setup
 
 
-def tree_modules(names, pxd):
-    """Compiled modules of the tree decoders: the loops of _emission.h, the same flags.
+def tree_modules(package, names, pxd):
+    """Compiled modules of a tree sub-package: the loops of _decoder/_emission.h, the same flags.
 
     ``pxd``: the declarations they share (their structs and cimported functions), on which
     each module depends as on _emission.h.
     """
-    shared = ["_emission.h", "_emission.pxd", "_pairs.pxd", *pxd]
+    shared = [
+        f"skmotion/tree/_decoder/{file}" for file in ("_emission.h", "_emission.pxd", "_pairs.pxd")
+    ]
     return [
         Extension(
-            f"skmotion.tree.{name}",
-            [f"skmotion/tree/{name}.pyx"],
-            depends=[f"skmotion/tree/{file}" for file in shared],
+            f"skmotion.tree.{package}.{name}",
+            [f"skmotion/tree/{package}/{name}.pyx"],
+            depends=shared + [f"skmotion/tree/{package}/{file}" for file in pxd],
+            include_dirs=["skmotion/tree/_decoder"],  # _emission.h, for _online's modules too
             extra_compile_args=["-O3", "-fopenmp-simd"],
         )
         for name in names
@@ -27,19 +30,21 @@ def tree_modules(names, pxd):
 
 
 # -fopenmp-simd honours the `omp simd` pragmas of _emission.h (vectorised sums) without
-# linking OpenMP. The beam search: the search itself (_beam), a layer's candidates and
-# emissions (_beam_candidates), its memory (_beam_memory) and the scoring passes
-# (_beam_passes), over the structs of _beam_structs.pxd.
+# linking OpenMP. The compiled decoder (tree/_decoder/): the beam search itself (_beam), a
+# layer's candidates and emissions (_beam_candidates), its memory (_beam_memory) and the
+# scoring passes (_beam_passes), over the structs of _beam_structs.pxd.
 beam = tree_modules(
+    "_decoder",
     ["_beam", "_beam_candidates", "_beam_memory", "_beam_passes"],
     ["_beam_structs.pxd", "_beam_candidates.pxd", "_beam_memory.pxd", "_beam_passes.pxd"],
 )
-# The causal stream's per-frame update (tree/_online_stream.py): the kernel (_online), its
-# per-frame work (_online_step) and answers (_online_answers) over the C state of
-# _online_structs.pxd, and the answers object it fills (_online_state).
+# The causal stream's per-frame update (tree/_online/, used by its _causal.py): the kernel
+# (_kernel), its per-frame work (_step) and answers (_answers) over the C state of
+# _structs.pxd, and the answers object it fills (_state).
 online = tree_modules(
-    ["_online", "_online_answers", "_online_state", "_online_step"],
-    ["_online_structs.pxd", "_online_answers.pxd", "_online_state.pxd", "_online_step.pxd"],
+    "_online",
+    ["_kernel", "_answers", "_state", "_step"],
+    ["_structs.pxd", "_answers.pxd", "_state.pxd", "_step.pxd"],
 )
 # The body frame of point trajectories, one pass over the frames (preprocessing/_position_frame).
 position_frame = Extension(

@@ -69,7 +69,7 @@ SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
 
 from skmotion.datasets import load_uea, make_motions  # noqa: E402
 from skmotion.tree import MotionTreeHMM  # noqa: E402
-from skmotion.tree._incremental import clip_counts, node_moments  # noqa: E402
+from skmotion.tree._growth._live import clip_counts, node_moments  # noqa: E402
 
 # -- data ------------------------------------------------------------------------------
 
@@ -432,7 +432,7 @@ def agreement(sets, lag=5):
     for name, loader in sets.items():
         Xtr, ytr, Xte, yte = loader()
         model = MotionTreeHMM().fit(Xtr, ytr)
-        batch_paths, batch_labels = model.decode(Xte), model.predict(Xte)
+        (_, batch_paths), batch_labels = model.decode(Xte), model.predict(Xte)
         same_node, same_lagged, same_label, correct, settled = [], [], [], [], {}
         for clip, label, path, batch_label in zip(Xte, yte, batch_paths, batch_labels):
             for mode in ("online", "exact"):

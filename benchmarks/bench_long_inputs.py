@@ -68,7 +68,7 @@ def worker(operation, n_frames, folder):
         clip = long_clip(base, n_frames)
         input_bytes = clip.nbytes
         if operation == "hmm_decode":
-            states, seconds, extra = _measure(lambda: model.decode([clip])[0])
+            states, seconds, extra = _measure(lambda: model.decode([clip])[1][0])
             out["finite"] = bool((states >= 0).all())
         elif operation == "hmm_score_samples":
             log_lik, seconds, extra = _measure(lambda: model.score_samples([clip])[0])

@@ -12,6 +12,7 @@ _SUBPACKAGES = (
     "control",
     "datasets",
     "decomposition",
+    "estimator_checks",
     "io",
     "kinematics",
     "metrics",

@@ -1,11 +1,10 @@
-"""The clip conformance checks, now installed with skmotion: see skmotion.utils.estimator_checks.
+"""The clip conformance checks, now installed with skmotion: see skmotion.estimator_checks.
 
 This module re-exports them for the project's tests written against the old place.
 """
 
-from skmotion.utils._conformance_helpers import _as_list, _fit  # noqa: F401
-from skmotion.utils.estimator_checks import *  # noqa: F403
-from skmotion.utils.estimator_checks import (  # noqa: F401
+from skmotion.estimator_checks import *  # noqa: F403
+from skmotion.estimator_checks import (  # noqa: F401
     as_dataframe,
     assert_outputs_equal,
     check_channel_mismatch,
@@ -30,3 +29,4 @@ from skmotion.utils.estimator_checks import (  # noqa: F401
     outputs,
     scoring_model,
 )
+from skmotion.estimator_checks._helpers import _as_list, _fit  # noqa: F401

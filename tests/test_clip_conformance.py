@@ -15,9 +15,9 @@ from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.utils.validation import check_is_fitted
 
 import skmotion
+import skmotion.estimator_checks as cc
 from skmotion.base import ClipEstimatorMixin
 from skmotion.utils import check_clips
-from skmotion.utils import estimator_checks as cc
 
 
 class ClipMeanCentroid(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -162,7 +162,7 @@ def test_default_data_fits_the_estimator():
 def test_importing_the_checks_needs_no_pytest():
     code = (
         "import sys; sys.modules['pytest'] = None\n"  # any `import pytest` now fails
-        "from skmotion.utils.estimator_checks import check_clip_estimator\n"
+        "from skmotion.estimator_checks import check_clip_estimator\n"
         "from skmotion.preprocessing import ResampleClips\n"
         "print(len(check_clip_estimator(ResampleClips(n_frames=8))))"
     )
@@ -206,5 +206,5 @@ def test_every_public_estimator_runs_the_checks():
     missing = sorted(estimators - _checked_in_tests())
     assert not missing, (
         f"no ClipCase runs the clip conformance checks on {missing}: add one to its tests "
-        "with skmotion.utils.estimator_checks.parametrize_with_clip_checks"
+        "with skmotion.estimator_checks.parametrize_with_clip_checks"
     )

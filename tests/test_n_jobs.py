@@ -17,7 +17,8 @@ from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor, _clip_svd
 from skmotion.neighbors import IntervalIndexNeighbors, _interval_neighbors, _psi, pairwise_psi
 from skmotion.preprocessing import FillGaps, LowPassFilter, VirtualMarkerTransform
-from skmotion.tree import MotionTreeHMM, _batch
+from skmotion.tree import MotionTreeHMM
+from skmotion.tree._decoder import _batch
 from skmotion.utils import _parallel
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
@@ -58,12 +59,16 @@ def _joint_angles():
     return data.clips, data.target
 
 
+def _logprob_and_paths(logprob, paths):
+    return [logprob, *paths]
+
+
 CASES = {
     "MotionTreeHMM": (
         MotionTreeHMM(max_depth=3, min_samples_leaf=4),
         _motions,
         lambda est, X: {
-            "decode": _as_list(est.decode(X)),
+            "decode": _logprob_and_paths(*est.decode(X)),
             "windows": _as_list(est.predict_proba_windows(X, 20, 7)),
         },
     ),

@@ -65,7 +65,7 @@ def _stream(model, X_test, y_test, lines):
     whole = model.stream(mode="exact")
     for start in range(0, len(X_test[b]), 7):  # chunks of 7 frames
         last = whole.update(X_test[b][start : start + 7])
-    same = bool((whole.path() == model.decode([X_test[b]])[0]).all())
+    same = bool((whole.path() == model.decode([X_test[b]])[1][0]).all())
     lines.append(
         f"the jump alone, in chunks of 7 frames: final decision '{last.label}' "
         f"(batch predict: '{model.predict([X_test[b]])[0]}'), node path equal to the batch "

@@ -1,12 +1,32 @@
 """The motion database: the motion tree, its transition graphs, decoding, and MotionTreeHMM."""
 
-from skmotion.tree._decode import NODE_PRIORS, beam_decode, exhaustive_viterbi, node_log_posterior
+import sys
+
+from skmotion.tree import _growth, _online
+from skmotion.tree._decoder import (
+    NODE_PRIORS,
+    beam_decode,
+    exhaustive_viterbi,
+    kbest_viterbi,
+    max_marginals,
+    node_log_posterior,
+)
 from skmotion.tree._encoder import MotionTreeEncoder
 from skmotion.tree._hmm import MotionTreeHMM
 from skmotion.tree._motion_tree import MotionTree
-from skmotion.tree._recipes import PAPER_SETTINGS
+from skmotion.tree._params import PAPER_SETTINGS
 from skmotion.tree._transitions import TransitionGraphs
-from skmotion.tree._viterbi import kbest_viterbi, max_marginals
+
+# Pickles made before the _growth and _online sub-packages name these modules:
+# they load from their new homes.
+sys.modules.update(
+    {
+        "skmotion.tree._incremental": _growth._live,
+        "skmotion.tree._moments": _growth._moments,
+        "skmotion.tree._online_stream": _online._causal,
+        "skmotion.tree._stream": _online._exact,
+    }
+)
 
 __all__ = [
     "MotionTree",

@@ -1,4 +1,4 @@
-"""Class probabilities, class-score features and novelty from a motion tree's scores.
+"""Class probabilities, class-score features, novelty and next nodes from a motion tree's scores.
 
 Free functions on arrays, used by :class:`MotionTreeHMM`: the per-frame
 normalised generation scores become probabilities through a softmax whose
@@ -14,14 +14,18 @@ from scipy.optimize import minimize_scalar
 from scipy.special import log_softmax, logsumexp
 from sklearn.model_selection import StratifiedGroupKFold, StratifiedKFold
 
+_NOVELTY_CHUNK = 4096  # frames per block of node densities in mixture_novelty
+
 __all__ = [
     "class_score_features",
+    "class_totals",
     "class_score_names",
     "fit_temperature",
     "held_out_folds",
     "layer_class_scores",
     "log_softmax_rows",
-    "mixture_log_density",
+    "mixture_novelty",
+    "next_node_probabilities",
     "per_frame",
     "sum_of_paths",
 ]
@@ -130,21 +134,88 @@ def fit_temperature(scores, y_index):
     return float(np.exp(result.x))
 
 
-def mixture_log_density(log_pdf, log_weights):
-    """Per-frame log density of a Gaussian mixture from its components' log densities.
+def mixture_novelty(tree, layer, frames, offsets, log_weights):
+    """Mean log density of each clip's frames under a layer's nodes as a Gaussian mixture.
 
     Parameters
     ----------
-    log_pdf : ndarray of shape (n_frames, n_components)
-        ``log N(x | k)`` of each frame at each component.
-    log_weights : ndarray of shape (n_components,)
-        Log mixing weights (summing to 1 after ``exp``).
+    tree : MotionTree
+    layer : int
+    frames : ndarray of shape (n_frames, n_channels)
+        The clips' frames, stacked, in the tree's (standardised) units.
+    offsets : ndarray of shape (n_clips + 1,)
+    log_weights : ndarray of shape (n_nodes,)
+        Log mixing weights of the layer's nodes (summing to 1 after ``exp``).
 
     Returns
     -------
-    log_density : ndarray of shape (n_frames,)
+    score : ndarray of shape (n_clips,)
+        ``mean_i log sum_k w_k N(x_i | k)`` over each clip's frames; ``-inf``
+        where a frame's density underflows.
     """
-    return logsumexp(log_pdf + log_weights, axis=1)
+    density = np.empty(len(frames))
+    for start in range(0, len(frames), _NOVELTY_CHUNK):  # bounded memory: chunk x nodes
+        chunk = frames[start : start + _NOVELTY_CHUNK]
+        with np.errstate(over="ignore", invalid="ignore"):
+            log_pdf = tree.log_likelihood(chunk, layer)
+        log_pdf[np.isnan(log_pdf)] = -np.inf
+        density[start : start + _NOVELTY_CHUNK] = logsumexp(log_pdf + log_weights, axis=1)
+    return np.add.reduceat(density, offsets[:-1]) / np.diff(offsets)
+
+
+def next_node_probabilities(paths, scores, graph, layer, n_steps):
+    """Each clip's node distribution ``n_steps`` frames after its end, on one graph.
+
+    The current node's probability is that of the decoder's ``n_paths`` best
+    sequences (their normalised probabilities, by last node), carried
+    ``n_steps`` transitions forward on ``graph``.
+
+    Parameters
+    ----------
+    paths : list of ndarray of shape (1, n_paths, n_frames_i)
+        Each clip's best sequences under the graph (``decode_clips``).
+    scores : ndarray of shape (n_clips, 1, n_scored, n_paths)
+        Their log scores; the last scored layer is ``layer``.
+    graph : TransitionGraphs
+        One graph (graph 0 is used).
+    layer : int
+    n_steps : int
+
+    Returns
+    -------
+    probabilities : ndarray of shape (n_clips, n_nodes[layer])
+    """
+    weights = np.exp(log_softmax_rows(scores[:, 0, -1]))  # the one graph, at the one layer
+    current = np.zeros((len(paths), graph.n_nodes(layer)))
+    for i, p in enumerate(paths):
+        valid = p[0, :, -1] >= 0
+        np.add.at(current[i], p[0, valid, -1], weights[i, valid])
+    return graph.propagate(layer, 0, current, n_steps)
+
+
+def class_totals(scores, graph_classes, n_classes, per_clip_graphs):
+    """Log generation probability of each clip under each class, over all scored layers.
+
+    The product over the scored layers of the summed ``n_paths`` best
+    sequences; with ``per_clip_graphs``, a class's value is its best graph's.
+
+    Parameters
+    ----------
+    scores : ndarray of shape (n_clips, n_graphs, n_scored, n_paths)
+    graph_classes : ndarray of int of shape (n_graphs,)
+    n_classes : int
+    per_clip_graphs : bool
+
+    Returns
+    -------
+    log_prob : ndarray of shape (n_clips, n_classes)
+    """
+    per_graph = sum_of_paths(scores).sum(axis=2)
+    if not per_clip_graphs:
+        return per_graph
+    out = np.full((len(scores), n_classes), -np.inf)
+    np.maximum.at(out.T, graph_classes, per_graph.T)
+    return out
 
 
 def held_out_folds(y_index, groups, n_folds):

@@ -24,8 +24,8 @@ from skmotion.tree._histograms import (
     second_order_features,
 )
 from skmotion.tree._motion_tree import MotionTree
+from skmotion.tree._params import TREE_CONSTRAINTS
 from skmotion.tree._routing import TreeRouter
-from skmotion.tree._split import SPLIT_CRITERIA
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._features import channel_names_in
 from skmotion.utils._progress import say
@@ -103,6 +103,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         residual blocks lose; in the study behind the defaults they lifted the
         CMU windows from 0.78 to 0.86 and held the other sets (user guide).
         0 leaves them out.
+    moment_pyramid : array-like of int, default=(1,)
+        The means also over each ``1/p`` of the clip, for each ``p`` (1: the
+        whole clip), ``sum(moment_pyramid) * n_channels`` columns: a coarse
+        trajectory of every channel, which says *when* the clip is where (the
+        root mean square stays over the whole clip). ``(1, 2, 4)`` is what
+        :class:`~skmotion.recognition.MotionClassifier` uses on skeletons
+        (user guide, ``docs/recognition.md``).
     power : float, default=0.5
         Every histogram entry is raised to this power; 1 keeps the shares.
     standardize : bool, default=True
@@ -169,14 +176,15 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
 
     _parameter_constraints = {
         "max_depth": [Interval(Integral, 1, None, closed="left")],
-        "min_samples_leaf": [Interval(Integral, 1, None, closed="left")],
-        "split": [StrOptions(set(SPLIT_CRITERIA))],
+        "min_samples_leaf": TREE_CONSTRAINTS["min_samples_leaf"],
+        "split": TREE_CONSTRAINTS["split"],
         "layers": [StrOptions({"all"}), "array-like"],
         "pyramid": ["array-like"],
         "transition_layers": ["array-like"],
         "residual_layers": ["array-like"],
         "residual_order": [Interval(Integral, 1, 2, closed="both")],
         "moments": [Interval(Integral, 0, 2, closed="both")],
+        "moment_pyramid": ["array-like"],
         "power": [Interval(Real, 0, 1, closed="right")],
         "standardize": ["boolean"],
         "sparse_output": ["boolean", StrOptions({"auto"})],
@@ -196,6 +204,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         residual_layers=(1, 3),
         residual_order=1,
         moments=2,
+        moment_pyramid=(1,),
         power=0.5,
         standardize=True,
         sparse_output="auto",
@@ -210,6 +219,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self.residual_layers = residual_layers
         self.residual_order = residual_order
         self.moments = moments
+        self.moment_pyramid = moment_pyramid
         self.power = power
         self.standardize = standardize
         self.sparse_output = sparse_output
@@ -234,6 +244,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         pyramid = _int_list("pyramid", self.pyramid, low=1)
         if not pyramid:
             raise ValueError("pyramid must name at least one level, e.g. (1,) or (1, 2, 3).")
+        moment_pyramid = _int_list("moment_pyramid", self.moment_pyramid, low=1)
+        if self.moments and not moment_pyramid:
+            raise ValueError("moment_pyramid must name at least one level, e.g. (1,) or (1, 2, 4).")
         clips = check_clips(X, estimator=self, reset=True)
         frames, _ = stack_clips(clips)
         self.moment_center_ = frames.mean(axis=0)
@@ -270,6 +283,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                 f"{bottom}) and moments=0; nothing to encode."
             )
         self._pyramid = pyramid
+        self._moment_pyramid = moment_pyramid
         self._router = TreeRouter(self.tree_, self.center_, self.scale_)
         self._blocks = feature_blocks(
             self.layers_, self.tree_.n_nodes, pyramid, self.transition_layers_
@@ -282,8 +296,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             self._residual_variances = node_variances(z, nodes, self._residual_means)
         orders = 2 if self._residual_variances else 1
         n_residual = self.tree_.n_nodes[self.residual_layers_].sum() * orders
+        n_moments = (sum(moment_pyramid) + self.moments - 1) if self.moments else 0
         self.n_features_out_ = sum(width for *_, width in self._blocks) + int(
-            (n_residual + self.moments) * self.n_features_in_
+            (n_residual + n_moments) * self.n_features_in_
         )
         return self
 
@@ -344,7 +359,12 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         if self.moments:
             parts.append(
                 moment_features(
-                    frames, offsets, self.moment_center_, self.moment_scale_, self.moments
+                    frames,
+                    offsets,
+                    self.moment_center_,
+                    self.moment_scale_,
+                    self.moments,
+                    self._moment_pyramid,
                 )
             )
         if sparse:
@@ -363,7 +383,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         ``layer<l>_node<k>_part<c>of<p>`` (occupancy), ``layer<l>_node<a>_to_node<b>``
         (transitions), ``layer<l>_node<k>_<channel>`` (residuals),
         ``layer<l>_node<k>_var_<channel>`` (their second order), ``mean_<channel>``
-        and ``rms_<channel>`` (moments).
+        (``mean_<channel>_part<c>of<p>`` over a part of the clip) and ``rms_<channel>``
+        (moments).
 
         Parameters
         ----------
@@ -382,4 +403,5 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             channel_names_in(self, input_features),
             second_order=bool(self._residual_variances),
             moments=self.moments,
+            moment_pyramid=self._moment_pyramid,
         )

@@ -36,7 +36,9 @@ def build_depth(max_depth, layers, transition_layers, residual_layers):
     return min(max_depth, max(wanted, default=1))
 
 
-def feature_names(blocks, residual_layers, n_nodes, channels, *, second_order, moments):
+def feature_names(
+    blocks, residual_layers, n_nodes, channels, *, second_order, moments, moment_pyramid=(1,)
+):
     """The encoder's column names, block after block (see ``get_feature_names_out``).
 
     ``blocks`` are the occupancy and transition blocks of :func:`feature_blocks`,
@@ -57,6 +59,13 @@ def feature_names(blocks, residual_layers, n_nodes, channels, *, second_order, m
         names += [f"layer{layer}_node{k}_{c}" for k in range(n_nodes[layer]) for c in channels]
     for layer in residual_layers if second_order else ():
         names += [f"layer{layer}_node{k}_var_{c}" for k in range(n_nodes[layer]) for c in channels]
-    for kind in ("mean", "rms")[:moments]:
-        names += [f"{kind}_{c}" for c in channels]
+    if moments:
+        for parts in moment_pyramid:
+            names += [
+                f"mean_{c}" if parts == 1 else f"mean_{c}_part{k + 1}of{parts}"
+                for k in range(parts)
+                for c in channels
+            ]
+    if moments >= 2:
+        names += [f"rms_{c}" for c in channels]
     return np.asarray(names, dtype=object)

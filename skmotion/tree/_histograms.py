@@ -146,7 +146,7 @@ def _signed_power_unit_norm(block, power):
     return block / np.where(norm > 0, norm, 1.0)
 
 
-def moment_features(frames, offsets, center, scale, order):
+def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
     """Per clip, the mean and root mean square of every channel in units of the training frames.
 
     With ``z = (x - center) / scale`` (``center``, ``scale``: the training
@@ -169,10 +169,16 @@ def moment_features(frames, offsets, center, scale, order):
     center, scale : ndarray of shape (n_channels,)
     order : int
         1 (means) or 2 (means, then root mean squares).
+    pyramid : sequence of int, default=(1,)
+        The means also over each ``1/p`` of the clip, for each ``p`` (1: the
+        whole clip): a coarse trajectory of every channel, *when* the clip is
+        where. The root mean square is over the whole clip only.
 
     Returns
     -------
-    features : ndarray of shape (n_clips, order * n_channels)
+    features : ndarray of shape (n_clips, (sum(pyramid) + order - 1) * n_channels)
+        The means cell by cell (level by level, cells in time order, each cell
+        every channel), then the root mean squares.
     """
     lengths = np.diff(offsets)
     clip = np.repeat(np.arange(len(lengths)), lengths)
@@ -182,11 +188,39 @@ def moment_features(frames, offsets, center, scale, order):
     # one centred copy, squared in place, the scale applied to the sums: a pass over a batch's
     # frames costs as much as the sums themselves
     centred = np.subtract(frames, center)
-    blocks = [(average @ centred) / scale]
+    blocks = [_cell_means(centred, clip, lengths, parts) / np.tile(scale, parts) for parts in pyramid]
     if order >= 2:
         np.square(centred, out=centred)
         blocks.append(np.sqrt(average @ centred) / scale - 1.0)
     return np.hstack(blocks)
+
+
+def _cell_means(centred, clip, lengths, parts):
+    """Per clip, the mean of each channel over each of ``parts`` equal spans of its frames.
+
+    Frame ``t`` of a clip of ``n`` frames is in cell ``t * parts // n`` (as the
+    occupancy pyramid cuts it); a cell that gets no frame (``n < parts``) takes
+    the mean of the frame that spans it, ``floor(c * n / parts)``, so short clips
+    still give every column. Returns ``(n_clips, parts * n_channels)``, cells in
+    time order.
+    """
+    n_clips = len(lengths)
+    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
+    if parts == 1:
+        cell = np.zeros(len(clip), dtype=np.intp)
+    else:
+        cell = (np.arange(len(clip)) - starts[clip]) * parts // lengths[clip]
+    key = clip * parts + cell
+    size = np.bincount(key, minlength=n_clips * parts)
+    average = sp.csr_matrix(
+        (1.0 / size[key], (key, np.arange(len(clip)))), shape=(n_clips * parts, len(clip))
+    )
+    means = average @ centred
+    empty = np.flatnonzero(size == 0)
+    if len(empty):
+        owner, c = np.divmod(empty, parts)
+        means[empty] = centred[starts[owner] + c * lengths[owner] // parts]
+    return means.reshape(n_clips, parts * centred.shape[1])
 
 
 def _node_averages(values, nodes, offsets, k):

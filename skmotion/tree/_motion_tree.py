@@ -5,15 +5,14 @@ construction is in :mod:`skmotion.tree._build`; this module holds the structure,
 its per-layer views and the routing of frames through the splits.
 """
 
-from numbers import Integral, Real
+from numbers import Integral
 
 import numpy as np
 
 from skmotion.base import VersionedStateMixin
 from skmotion.tree._build import build_nodes
-from skmotion.tree._gaussian import COVARIANCE_TYPES, Gaussians
-from skmotion.tree._split import SPLIT_CRITERIA
-from skmotion.utils._validation import check_int
+from skmotion.tree._gaussian import Gaussians
+from skmotion.tree._params import PAPER_TREE, TreeParams
 
 __all__ = ["MotionTree"]
 
@@ -121,14 +120,19 @@ class MotionTree(VersionedStateMixin):
         cls,
         frames,
         *,
-        max_depth=None,
-        min_samples_split=2,
-        min_samples_leaf=16,
-        split="min_error",
-        covariance_type="diag",
-        reg_covar=1e-6,
+        max_depth=PAPER_TREE.max_depth,
+        min_samples_split=PAPER_TREE.min_samples_split,
+        min_samples_leaf=PAPER_TREE.min_samples_leaf,
+        split=PAPER_TREE.split,
+        covariance_type=PAPER_TREE.covariance_type,
+        reg_covar=PAPER_TREE.reg_covar,
     ):
         """Build the tree over frames.
+
+        The parameters are those of :class:`~skmotion.tree._params.TreeParams`,
+        which checks them; the defaults are the paper's tree
+        (:data:`~skmotion.tree._params.PAPER_TREE`), where the estimators
+        declare their measured ones (the user guide's "Build parameters").
 
         Parameters
         ----------
@@ -158,6 +162,19 @@ class MotionTree(VersionedStateMixin):
         -------
         tree : MotionTree
         """
+        params = TreeParams(
+            max_depth=max_depth,
+            min_samples_split=min_samples_split,
+            min_samples_leaf=min_samples_leaf,
+            split=split,
+            covariance_type=covariance_type,
+            reg_covar=reg_covar,
+        )
+        return cls.from_params(frames, params)
+
+    @classmethod
+    def from_params(cls, frames, params):
+        """Build the tree over frames with the parameters of a ``TreeParams``."""
         X = np.asarray(frames, dtype=np.float64)
         if X.ndim != 2 or len(X) == 0 or X.shape[1] == 0:
             raise ValueError(
@@ -168,27 +185,8 @@ class MotionTree(VersionedStateMixin):
             raise ValueError(
                 f"frames must be finite; frame {frame}, channel {channel} is {X[frame, channel]}."
             )
-        check_int("max_depth", max_depth, 0, allow_none=True)
-        check_int("min_samples_split", min_samples_split, 2)
-        check_int("min_samples_leaf", min_samples_leaf, 1)
-        if split not in SPLIT_CRITERIA:
-            raise ValueError(f"split must be one of {SPLIT_CRITERIA}; got {split!r}.")
-        if covariance_type not in COVARIANCE_TYPES:
-            raise ValueError(
-                f"covariance_type must be one of {COVARIANCE_TYPES}; got {covariance_type!r}."
-            )
-        if not isinstance(reg_covar, Real) or not reg_covar > 0:
-            raise ValueError(f"reg_covar must be a positive number; got {reg_covar!r}.")
-        nodes = build_nodes(
-            np.ascontiguousarray(X),
-            max_depth=max_depth,
-            min_samples_split=min_samples_split,
-            min_samples_leaf=min_samples_leaf,
-            split=split,
-            covariance_type=covariance_type,
-            reg_covar=reg_covar,
-        )
-        return cls(**nodes, covariance_type=covariance_type)
+        nodes = build_nodes(np.ascontiguousarray(X), **params.as_dict())
+        return cls(**nodes, covariance_type=params.covariance_type)
 
     # -- sizes and layer structure ------------------------------------------------
 

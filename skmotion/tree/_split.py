@@ -8,9 +8,6 @@ import numpy as np
 
 __all__ = ["SPLIT_CRITERIA", "best_split", "split_scores"]
 
-#: The split criteria :func:`best_split` knows.
-SPLIT_CRITERIA = ("min_error", "two_means", "median")
-
 
 def _prefix_moments(values):
     """Sizes, means and variances of every prefix/suffix pair of ``values``.
@@ -31,6 +28,32 @@ def _prefix_moments(values):
     var1 = s2 / i - mean1 * mean1
     var2 = (total2 - s2) / k - mean2 * mean2
     return i, k, mean1, mean2, var1, var2
+
+
+def _min_error(values, var_floor):
+    """Kittler-Illingworth: ``i ln v1 + k ln v2 - 2 (i ln i + k ln k)``."""
+    i, k, _, _, var1, var2 = _prefix_moments(values)
+    floor = max(var_floor, np.finfo(np.float64).tiny)
+    v1 = np.maximum(var1, floor)
+    v2 = np.maximum(var2, floor)
+    return i * np.log(v1) + k * np.log(v2) - 2.0 * (i * np.log(i) + k * np.log(k))
+
+
+def _two_means(values, var_floor):
+    """1-D 2-means: minus the between-sides sum of squares (the total is the same for every cut)."""
+    i, k, mean1, mean2, _, _ = _prefix_moments(values)
+    return -(i * mean1 * mean1 + k * mean2 * mean2)
+
+
+def _median(values, var_floor):
+    """The distance of the cut from the middle."""
+    n = len(values)
+    return np.abs(np.arange(1, n) - n / 2.0)
+
+
+#: The split criteria :func:`best_split` knows: each scores every cut of sorted values.
+SPLIT_RULES = {"min_error": _min_error, "two_means": _two_means, "median": _median}
+SPLIT_CRITERIA = tuple(SPLIT_RULES)
 
 
 def split_scores(sorted_values, criterion, *, var_floor=0.0):
@@ -63,19 +86,10 @@ def split_scores(sorted_values, criterion, *, var_floor=0.0):
     >>> int(np.argmin(split_scores(values, "two_means"))) + 1
     3
     """
-    n = len(sorted_values)
-    if criterion == "median":
-        return np.abs(np.arange(1, n) - n / 2.0)
-    i, k, mean1, mean2, var1, var2 = _prefix_moments(np.asarray(sorted_values, dtype=np.float64))
-    if criterion == "two_means":
-        # Total sum of squares minus the between-sides part; only the latter varies.
-        return -(i * mean1 * mean1 + k * mean2 * mean2)
-    if criterion == "min_error":
-        floor = max(var_floor, np.finfo(np.float64).tiny)
-        v1 = np.maximum(var1, floor)
-        v2 = np.maximum(var2, floor)
-        return i * np.log(v1) + k * np.log(v2) - 2.0 * (i * np.log(i) + k * np.log(k))
-    raise ValueError(f"criterion must be one of {SPLIT_CRITERIA}, got {criterion!r}.")
+    rule = SPLIT_RULES.get(criterion)
+    if rule is None:
+        raise ValueError(f"criterion must be one of {SPLIT_CRITERIA}, got {criterion!r}.")
+    return rule(np.asarray(sorted_values, dtype=np.float64), var_floor)
 
 
 def best_split(sorted_values, criterion, *, min_samples_leaf=1, tol=0.0):

@@ -24,7 +24,7 @@ import scipy.sparse as sp
 
 from skmotion.base import VersionedStateMixin
 
-__all__ = ["TransitionGraphs"]
+__all__ = ["TransitionGraphs", "count_database_graphs"]
 
 # Graphs whose dense table (n_graphs * K * K) is at most this many entries keep
 # one, so lookups are one gather instead of a binary search.
@@ -272,3 +272,52 @@ class TransitionGraphs(VersionedStateMixin):
     def count_matrix(self, layer):
         """All graphs' counts at a layer: a sparse ``(n_graphs * K, K)`` matrix, graph by graph."""
         return self._counts[layer]
+
+
+def count_database_graphs(tree, labels, offsets, y_index, *, n_classes, per_clip, smoothing):
+    """A motion database's graphs from its routed frames: the global graph and the classifying ones.
+
+    Parameters
+    ----------
+    tree : MotionTree
+    labels : list of ndarray
+        Per layer, the node of every frame (``tree.iter_apply`` of the stacked clips).
+    offsets : ndarray of shape (n_clips + 1,)
+    y_index : ndarray of shape (n_clips,)
+        Each clip's class, an index below ``n_classes``.
+    n_classes : int
+    per_clip : bool
+        One classifying graph per clip; else one per class.
+    smoothing : float
+
+    Returns
+    -------
+    global_graph : TransitionGraphs
+        One graph of all clips.
+    graphs : TransitionGraphs
+        One graph per class, or per clip.
+    graph_classes : ndarray of shape (n_graphs,)
+        The class of each graph of ``graphs``.
+    """
+    n_clips = len(offsets) - 1
+    global_graph = TransitionGraphs.count(
+        labels,
+        tree.n_nodes,
+        offsets=offsets,
+        graph_of_clip=np.zeros(n_clips, dtype=np.intp),
+        n_graphs=1,
+        smoothing=smoothing,
+    )
+    if per_clip:
+        graph_of_clip, graph_classes = np.arange(n_clips), y_index
+    else:
+        graph_of_clip, graph_classes = y_index, np.arange(n_classes)
+    graphs = TransitionGraphs.count(
+        labels,
+        tree.n_nodes,
+        offsets=offsets,
+        graph_of_clip=graph_of_clip,
+        n_graphs=len(graph_classes),
+        smoothing=smoothing,
+    )
+    return global_graph, graphs, graph_classes

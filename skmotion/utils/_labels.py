@@ -4,8 +4,10 @@ from numbers import Number
 
 import numpy as np
 import pandas as pd
+from sklearn.utils.multiclass import check_classification_targets
+from sklearn.utils.validation import column_or_1d
 
-__all__ = ["check_label_types"]
+__all__ = ["check_clip_labels", "check_label_types"]
 
 
 def _kind(value):
@@ -77,4 +79,29 @@ def check_label_types(y, input_name="y"):
             f"{input_name} mixes label types: {a} ({u!r} at clip {i}) and {b} ({v!r} at clip "
             f"{j}). Use labels of one type, e.g. [str(v) for v in {input_name}]."
         )
+    return y
+
+
+def check_clip_labels(y, n_clips):
+    """``y`` as a 1-D array of classification labels, one per clip.
+
+    Raises a ValueError when the counts differ or the labels are not classes
+    (sklearn's ``check_classification_targets``).
+
+    Examples
+    --------
+    >>> from skmotion.utils._labels import check_clip_labels
+    >>> check_clip_labels(["walk", "run"], 2).tolist()
+    ['walk', 'run']
+    >>> check_clip_labels(["walk"], 2)
+    Traceback (most recent call last):
+    ...
+    ValueError: y has 1 labels but X holds 2 clips; give one label per clip.
+    """
+    y = column_or_1d(np.asarray(y), warn=True)
+    if len(y) != n_clips:
+        raise ValueError(
+            f"y has {len(y)} labels but X holds {n_clips} clips; give one label per clip."
+        )
+    check_classification_targets(y)
     return y

@@ -113,11 +113,10 @@ ONE_FRAME = {
 
 
 def _finite(result):
-    parts = result if isinstance(result, (list, tuple)) else [result]
-    return all(
-        np.isfinite(np.asarray(p, dtype=float)).all()
-        for p in parts
-        if np.asarray(p).dtype.kind in "fiub"
+    if isinstance(result, (list, tuple)):  # per-clip arrays, or decode's (logprob, paths)
+        return all(_finite(part) for part in result)
+    return np.asarray(result).dtype.kind not in "fiub" or bool(
+        np.isfinite(np.asarray(result, dtype=float)).all()
     )
 
 

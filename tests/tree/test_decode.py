@@ -14,7 +14,7 @@ from skmotion.tree import (
     kbest_viterbi,
     node_log_posterior,
 )
-from skmotion.tree._layout import gaussian_arrays, transition_table
+from skmotion.tree._decoder._tables import gaussian_arrays, transition_table
 
 
 @pytest.fixture(scope="module")
@@ -273,7 +273,7 @@ def test_ten_thousand_frames_keep_finite_probabilities(model):
 
 
 def test_the_normaliser_survives_underflow():
-    from skmotion.tree._decode import _log_normaliser
+    from skmotion.tree._decoder._decode import _log_normaliser
 
     log_po = np.array([[0.0, -2000.0, -2001.0], [-5.0, -6.0, -7.0]])
     allowed = np.array([[True, True, True], [False, True, True]])

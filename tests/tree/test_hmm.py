@@ -109,8 +109,14 @@ def test_decode_and_predict_next_follow_the_global_graph(motions):
     clip = X[1][:12]
     query = (clip - model.center_) / model.scale_
     best, scores = exhaustive_viterbi(model.tree_, model.global_graph_, -1, query, 0, n_paths=8)
-    np.testing.assert_array_equal(model.decode([clip])[0], best[0])
-    assert (model.decode([clip], layer=0)[0] == 0).all()
+    logprob, paths = model.decode([clip])
+    np.testing.assert_array_equal(paths[0], best[0])
+    # the path's log probability is the exhaustive Viterbi's best score (node_prior="layer":
+    # the global graph visits every node, so both priors spread over the whole layer)
+    np.testing.assert_allclose(logprob, scores[:1], rtol=1e-12)
+    # at the root, every frame has probability 1
+    logprob, paths = model.decode([clip], layer=0)
+    assert (paths[0] == 0).all() and logprob.tolist() == [0.0]
     # the current node's probability, carried two steps by the global graph's matrix
     layer = model.layer_
     weights = np.exp(scores - logsumexp(scores))
@@ -173,7 +179,7 @@ def test_hard_cases_give_finite_answers(score_layers):
             assert np.isfinite(model.score_samples(query)).all()
             assert np.isfinite(model.predict_proba(query)).all()
             assert model.predict(query)[0] in model.classes_
-            assert len(model.decode(query)[0]) == len(query[0])
+            assert len(model.decode(query)[1][0]) == len(query[0])
             assert np.isfinite(model.predict_next(query).probabilities).all()
     assert model.tree_.count.min() >= 1
 

@@ -1,12 +1,16 @@
 """MotionTree: every layer partitions the frames, routing reproduces the build, node statistics."""
 
+import inspect
+from dataclasses import fields
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from skmotion.datasets import make_motions
-from skmotion.tree import MotionTree
+from skmotion.tree import MotionTree, MotionTreeEncoder, MotionTreeHMM
+from skmotion.tree._params import PAPER_TREE, TREE_CONSTRAINTS, TreeParams
 from skmotion.tree._split import SPLIT_CRITERIA
 
 
@@ -182,3 +186,28 @@ def test_bad_frames_and_layers(rng):
     assert tree.check_layer(-1) == 1
     with pytest.raises(ValueError, match=r"frames must have shape \(n_frames, 2\)"):
         tree.apply(np.zeros((3, 5)))
+
+
+def test_one_description_of_the_build_parameters(rng):
+    """TreeParams names, constrains and defaults the build's parameters for every caller."""
+    names = [f.name for f in fields(TreeParams)]
+    assert set(TREE_CONSTRAINTS) == set(names)
+    for name in names:  # the estimators validate with the one table
+        assert MotionTreeHMM._parameter_constraints[name] is TREE_CONSTRAINTS[name]
+    for name in ("min_samples_leaf", "split"):
+        assert MotionTreeEncoder._parameter_constraints[name] is TREE_CONSTRAINTS[name]
+    # MotionTreeHMM's defaults are TreeParams'; MotionTree.build declares the paper's tree
+    assert TreeParams.of(MotionTreeHMM()) == TreeParams()
+    build = inspect.signature(MotionTree.build).parameters
+    assert {name: build[name].default for name in names} == PAPER_TREE.as_dict()
+    # fit builds its tree with its parameters: the same tree as MotionTree.build's
+    frames = rng.normal(size=(300, 3))
+    model = MotionTreeHMM(max_depth=3, split="median", calibration_cv=None)
+    model.fit([frames[:150], frames[150:]], [0, 1])
+    tree = MotionTree.build(
+        (frames - model.center_) / model.scale_, **TreeParams.of(model).as_dict()
+    )
+    np.testing.assert_array_equal(model.tree_.threshold, tree.threshold)
+    np.testing.assert_array_equal(model.tree_.count, tree.count)
+    with pytest.raises(ValueError, match="split must be one of"):
+        TreeParams(split="gini")

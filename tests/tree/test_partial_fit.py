@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTree, MotionTreeHMM, TransitionGraphs
 from skmotion.tree._gaussian import centred_moments, estimate_covariance
-from skmotion.tree._moments import Moments
+from skmotion.tree._growth._moments import Moments
 
 
 def _data(n_per_class=4, classes=("walk", "jump", "wave"), seed=0):

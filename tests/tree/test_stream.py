@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTreeHMM, exhaustive_viterbi
 from skmotion.tree._calibration import sum_of_paths as _sum_of_paths
-from skmotion.tree._decode import _log_normaliser
+from skmotion.tree._decoder._decode import _log_normaliser
 
 
 def _data():
@@ -42,7 +42,7 @@ def test_every_prefix_gives_the_batch_answers(name):
         if t % 7 and t != len(clip) - 1:
             continue
         prefix = [clip[: t + 1]]
-        path = model.decode(prefix)[0]
+        path = model.decode(prefix)[1][0]
         assert state.frame == t and state.node == path[-1]
         assert state.lagged_node == (path[-4] if t >= 3 else -1)
         np.testing.assert_array_equal(state.proba, model.predict_proba(prefix)[0])
@@ -50,7 +50,7 @@ def test_every_prefix_gives_the_batch_answers(name):
         nxt = model.predict_next(prefix, n_best=2)
         np.testing.assert_array_equal(state.next_nodes, nxt.nodes[0])
         np.testing.assert_array_equal(state.next_proba, nxt.probabilities[0])
-    np.testing.assert_array_equal(stream.path(), model.decode([clip])[0])
+    np.testing.assert_array_equal(stream.path(), model.decode([clip])[1][0])
 
 
 @settings(max_examples=20)
@@ -69,7 +69,7 @@ def test_any_chunking_ends_with_the_batch_decode_and_prediction(clip_index, cuts
         state = stream.update(clip[start : start + size])
         start += size
     assert state.frame == len(clip) - 1
-    path = model.decode([clip])[0]
+    path = model.decode([clip])[1][0]
     np.testing.assert_array_equal(stream.path(), path)
     assert state.node == path[-1]
     assert state.label == model.predict([clip])[0]
@@ -127,10 +127,10 @@ def test_an_upper_layer_streams_its_own_decode(name):
     for t in range(0, len(clip), 9):
         state = stream.update(clip[t : t + 9])
         prefix = [clip[: t + 9]]
-        path = model.decode(prefix, layer=2)[0]
+        path = model.decode(prefix, layer=2)[1][0]
         assert state.node == path[-1] and state.lagged_node == path[-5]
         np.testing.assert_array_equal(state.proba, model.predict_proba(prefix)[0])
-    np.testing.assert_array_equal(stream.path(), model.decode([clip], layer=2)[0])
+    np.testing.assert_array_equal(stream.path(), model.decode([clip], layer=2)[1][0])
 
 
 def test_a_stream_refuses_a_model_fit_again():

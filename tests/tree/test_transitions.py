@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from skmotion.tree import TransitionGraphs, _transitions
-from skmotion.tree._layout import transition_table
+from skmotion.tree._decoder._tables import transition_table
 
 
 def loop_counts(labels, offsets, graph_of_clip, n_graphs, k):
