@@ -184,19 +184,12 @@ def subject_confound(labels, sources, subjects, subjects_known, stems):
     if all(_SUBJECT_NAME.match(n) for n in names):
         shown = ", ".join(names[:4]) + (", ..." if len(names) > 4 else "")
         return f"the folder names look like people ({shown})"
+    # Same file names in every folder (walk/take1, run/take1) are as common for motion
+    # folders as for subject folders, so they are not taken as a sign (``stems`` unused).
     people = defaultdict(set)
-    where = defaultdict(set)
     for k in folder:
         people[labels[k]].add(subjects[k])
-        where[stems[k]].add(labels[k])
     if subjects_known and all(len(p) == 1 for p in people.values()):
         pairs = ", ".join(f"{n} = {next(iter(people[n]))}" for n in names[:3])
         return f"each of these labels holds a single subject ({pairs}, ...)"
-    shared = [s for s, w in where.items() if len(w) > 1]
-    if len(shared) * 2 >= len(where):
-        shown = ", ".join(sorted(shared)[:3])
-        return (
-            f"the same file names recur across the folders ({shown}): the folders look like "
-            "people who each recorded the same trials"
-        )
     return None

@@ -485,8 +485,7 @@ def load_motion_folder(
     telling them apart. The loader warns when the folder-name labels look
     like people (``S01``, ``sub-2``, ``07``), when the subjects are known
     (CMU trial names, a folder level of person-like names) and each label
-    holds one of them, or when the same file names recur across the
-    folders. A folder level of person-like names (``S01/walk/a.bvh``) gives
+    holds one of them. A folder level of person-like names (``S01/walk/a.bvh``) gives
     the subjects, and the label is the rest of the path (``walk``).
 
     Examples
