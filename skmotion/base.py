@@ -20,7 +20,7 @@ __all__ = [
     "compatible_versions",
 ]
 
-OUTPUT_KINDS = frozenset({"clips", "table", "labels", "scores", "segments"})
+OUTPUT_KINDS = frozenset({"aeon", "clips", "table", "labels", "scores", "segments"})
 
 
 @dataclass(frozen=True)
@@ -31,10 +31,11 @@ class MotionTags:
     ----------
     variable_length : bool, default=True
         Clips of one collection may have different numbers of frames.
-    output_kind : {"clips", "table", "labels", "scores", "segments"}, default="labels"
+    output_kind : {"clips", "table", "labels", "scores", "segments", "aeon"}, default="labels"
         What ``transform``/``predict`` returns: clips (clip-to-clip transformer),
         a table ``(n_clips, n_features)``, one label per clip, scores, or per
-        clip a list of segment rows (``(n_segments_i, n_features)`` arrays).
+        clip a list of segment rows (``(n_segments_i, n_features)`` arrays),
+        or aeon's channels-first collection (:class:`~skmotion.preprocessing.ToAeon`).
     requires_skeleton : bool, default=False
         Whether the estimator needs a ``Skeleton`` to interpret its input.
     min_frames : int, default=1

@@ -28,12 +28,19 @@ def _demo(args):
         if not folder.is_dir():
             what = "is a file, not a folder" if folder.exists() else "does not exist"
             return _demo_error(f"--data {args.data} {what}")
-        if args.index is not None and not Path(args.index).is_file():
-            return _demo_error(f"--index {args.index}: no such file")
+        for flag, value in (("--index", args.index), ("--labels", args.labels)):
+            if value is not None and not Path(value).is_file():
+                return _demo_error(f"{flag} {value}: no such file")
         sections = tuple(
             "skmotion._demo.data_folder" if s == "skmotion._demo.data" else s for s in SECTIONS
         )
-        options = {"data_folder": args.data, "frame_rate": args.frame_rate, "index": args.index}
+        options = {
+            "data_folder": args.data,
+            "frame_rate": args.frame_rate,
+            "index": args.index,
+            "labels": args.labels,
+            "layout": args.layout,
+        }
     out = None if args.no_out else args.out
     if out is not None:
         try:
@@ -69,14 +76,42 @@ def _marker_preset(skeleton):
         return ["marker preset: none fits (define a MarkerSet)"]
 
 
-def _info(args):
-    from skmotion.io._info import describe_file
+def _layout_notes(motion, layout):
+    """The ``layout check`` lines of ``skmotion info --layout`` (layouts live in kinematics)."""
+    from skmotion.kinematics import check_layout
 
     try:
-        lines = describe_file(
-            args.file, asf=args.asf, frame_rate=args.frame_rate, skeleton_notes=_marker_preset
-        )
-    except (OSError, ValueError, ImportError) as exc:
+        problems = check_layout([motion.channels], layout)
+    except ValueError as exc:
+        return [f"layout check: not run ({exc})"]
+    if not problems:
+        return [f"layout check: the data fit the joint order of {layout} (bones, sides, posture)"]
+    return [f"layout check: WARNING, the data do not fit the joint order of {layout}:"] + [
+        f"  - {problem}" for problem in problems
+    ]
+
+
+def _info(args):
+    from pathlib import Path
+
+    from skmotion.io._info import describe_file, describe_folder
+
+    notes = None
+    if args.layout is not None:
+        notes = lambda motion: _layout_notes(motion, args.layout)  # noqa: E731
+    try:
+        if Path(args.file).is_dir():
+            lines = describe_folder(args.file, layout=args.layout, frame_rate=args.frame_rate)
+        else:
+            lines = describe_file(
+                args.file,
+                asf=args.asf,
+                frame_rate=args.frame_rate,
+                layout=args.layout,
+                skeleton_notes=_marker_preset,
+                position_notes=notes,
+            )
+    except (OSError, ValueError, ImportError, TypeError) as exc:
         print(f"skmotion info: {exc}", file=sys.stderr)
         return 1
     print("\n".join(lines))
@@ -112,10 +147,28 @@ def build_parser():
         help="with --data: the CMU index CSV (default: one found in FOLDER or a folder above it)",
     )
     demo.add_argument(
+        "--labels",
+        metavar="CSV",
+        default=None,
+        help="with --data: the label (and optionally the subject) of every file, a CSV with "
+        "columns path,label[,subject] (path relative to FOLDER, a file name, or a name without "
+        "suffix); without it, labels guessed from folder names that look like subjects are "
+        "refused",
+    )
+    demo.add_argument(
+        "--layout",
+        metavar="NAME",
+        default=None,
+        help="with --data: read the keypoint files (.npy .npz .csv .txt) in FOLDER in this joint "
+        "order (kinect_v1, kinect_v2, azure_kinect, coco17, openpose_body25, mediapipe_pose33, "
+        "h36m17, smpl24), at --frame-rate, and check that the order fits the data",
+    )
+    demo.add_argument(
         "--frame-rate",
         type=float,
         default=30.0,
-        help="with --data: resample every clip to this rate (default 30 Hz)",
+        help="with --data: resample every clip to this rate (default 30 Hz); with --layout also "
+        "the keypoint files' rate",
     )
     demo.add_argument(
         "--out",
@@ -128,7 +181,7 @@ def build_parser():
     demo.add_argument("--no-out", action="store_true", help="print the report only; write no files")
     demo.add_argument("--quiet", action="store_true", help="no progress lines on standard error")
     demo.set_defaults(func=_demo)
-    from skmotion.io._info import formats_help
+    from skmotion.io._formats import formats_help
 
     info = commands.add_parser(
         "info",
@@ -136,7 +189,9 @@ def build_parser():
         description="Formats read:\n" + formats_help(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    info.add_argument("file", help="a motion file of a format listed above")
+    info.add_argument(
+        "file", help="a motion file of a format listed above, or a folder of them (a summary)"
+    )
     info.add_argument(
         "--asf", default=None, help="the skeleton of an .amc file (default: NN.asf beside it)"
     )
@@ -145,6 +200,13 @@ def build_parser():
         type=float,
         default=None,
         help="frames per second of a file that does not record it (keypoint files)",
+    )
+    info.add_argument(
+        "--layout",
+        metavar="NAME",
+        default=None,
+        help="the joint order of a keypoint file (kinect_v1, kinect_v2, coco17, ...; a flat "
+        "frames x joints*3 file needs it); checks that the order fits the data",
     )
     info.set_defaults(func=_info)
     return parser

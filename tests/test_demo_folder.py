@@ -142,11 +142,12 @@ def test_bad_folders_give_one_line_and_status_2(tmp_path, kind):
     assert str(target) in result.stderr
 
 
-def _folder_report(folder, sections, capsys=None):
+def _folder_report(folder, sections, capsys=None, **options):
     lines = []
     context = run_demo(
-        lines.append, sections=sections, data_folder=str(folder), frame_rate=30.0, out=None
-    )
+        lines.append, sections=sections, data_folder=str(folder), frame_rate=30.0, out=None,
+        **options,
+    )  # fmt: skip
     return "\n".join(lines), context
 
 
@@ -163,11 +164,16 @@ FOLDER_SECTIONS = (
 
 def test_single_subject_classes_are_split_by_trial_with_every_section_on_the_folder(tmp_path):
     # Subject 05 walks, subject 06 jumps: subject-wise testing would test unseen classes.
-    # (no index: the labels are the folder names, the subjects the NN of NN_TT)
+    # (no index: the labels come from a labels file, the subjects from the NN of NN_TT;
+    # folder-name labels, each of one subject, would be refused: see test_folder_labels)
     names = [f"walk/05_{t:02d}.bvh" for t in range(1, 5)]
     names += [f"jump/06_{t:02d}.bvh" for t in range(1, 5)]
     root = _write_folder(tmp_path, names, ["walk", "jump"], index=False)
-    text, context = _folder_report(root, FOLDER_SECTIONS)
+    text, _ = _folder_report(root, ("skmotion._demo.data_folder",))
+    assert "NOT EVALUATED: the labels come from folder names, and each of these labels" in text
+    labels = tmp_path / "labels.csv"
+    labels.write_text("path,label\n" + "".join(f"{n},{n.split('/')[0]}\n" for n in names))
+    text, context = _folder_report(root, FOLDER_SECTIONS, labels=str(labels))
     assert "evaluation: split by trial (stratified)" in text
     assert "subject-wise" not in text.split("== Evaluation")[0]  # no subject-wise accuracy
     assert "nested subject-wise CV: not run" in text
@@ -211,8 +217,12 @@ def test_shared_data_gets_index_labels_and_a_possible_split(shared_data, sub):
 def test_progress_on_stderr_only_when_asked(tmp_path, capsys):
     names = [f"walk/05_{t:02d}.bvh" for t in range(1, 4)] + [f"jump/06_{t:02d}.bvh" for t in (1, 2)]
     root = _write_folder(tmp_path, names, ["walk", "jump"], index=False)
+    labels = tmp_path / "labels.csv"
+    labels.write_text("path,label\n" + "".join(f"{n},{n.split('/')[0]}\n" for n in names))
     sections = ("skmotion._demo.data_folder",)
-    run_demo(lambda line: None, sections=sections, data_folder=str(root), verbose=1)
+    run_demo(
+        lambda line: None, sections=sections, data_folder=str(root), verbose=1, labels=str(labels)
+    )
     err = capsys.readouterr().err
     assert "[skmotion] demo: Data: motion files ..." in err
     assert re.search(r"\[skmotion\] baseline CV.*\d+/\d+", err)  # the folds, as they finish

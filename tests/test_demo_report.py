@@ -50,3 +50,16 @@ def test_no_output_folder_writes_nothing(tmp_path, monkeypatch):
     context = run_demo(lines.append, sections=("skmotion._demo.data",))
     assert context.report_path is None and not list(tmp_path.iterdir())
     assert not any("figure" in line for line in lines)
+
+
+def test_long_lines_wrap_and_tables_keep_their_spaces(tmp_path):
+    from skmotion._demo._report import write_report
+
+    long_line = "error: " + "x" * 400
+    table = "  walk     3     0"
+    path = write_report(tmp_path / "r.html", "t", [("s", [long_line, table], [])])
+    text = path.read_text()
+    style = re.search(r"pre\{([^}]*)\}", text).group(1)
+    assert "white-space:pre-wrap" in style and "overflow-wrap:anywhere" in style
+    assert "overflow-x" not in style  # no horizontal scrolling that hides the end of a line
+    assert html.escape(table) in text  # the aligning spaces are still there

@@ -21,6 +21,7 @@ from skmotion.preprocessing import (
     FlattenClips,
     LowPassFilter,
     ResampleClips,
+    ToAeon,
     VirtualMarkerTransform,
 )
 from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
@@ -105,6 +106,7 @@ CASES = {
     "FlattenClips": (FlattenClips(), _equal_length, {}),
     "LowPassFilter": (LowPassFilter(order=4), _motions, {}),
     "FillGaps": (FillGaps(layout="kinect_v1"), _holed_positions, {}),
+    "ToAeon": (ToAeon(), _motions, {}),
 }
 
 

@@ -159,3 +159,31 @@ def test_a_named_layout_is_drawn_upright_with_its_own_bones(name):
     shoulder, ankle = layout.index(on["left_shoulder"]), layout.index(on["left_ankle"])
     # the shoulder is above the ankle along the drawn up axis, whichever sign the layout uses
     assert (body.positions[:, shoulder, body.up] > body.positions[:, ankle, body.up]).all()
+
+
+@pytest.mark.parametrize("motion", ["squat", "walk", "wave"])
+def test_clip_poses_never_overlap_and_the_root_path_runs_through_them(motion):
+    from skmotion.datasets import make_motions
+
+    data = make_motions(n_clips_per_class=1, classes=[motion], random_state=0)
+    figure = plotting.plot_clip(data.clips[0], data.skeletons[0], frame_rate=30.0, n_poses=6)
+    ax = figure.axes[0]
+    lines = ax.get_lines()
+    path = np.column_stack(lines[-1].get_data_3d())
+    assert lines[-1].get_label() == "root path (Hips)"
+    n_bones = (len(lines) - 1) // 6
+    poses = [
+        np.vstack([np.column_stack(line.get_data_3d()) for line in lines[k : k + n_bones]])
+        for k in range(0, 6 * n_bones, n_bones)
+    ]
+    # along the direction from the first pose's root to the last's, each pose starts after
+    # the previous one ends
+    roots = np.array(
+        [np.column_stack(lines[k].get_data_3d())[0] for k in range(0, 6 * n_bones, n_bones)]
+    )
+    direction = (roots[-1] - roots[0]) / np.linalg.norm(roots[-1] - roots[0])
+    spans = [(p @ direction).min() for p in poses], [(p @ direction).max() for p in poses]
+    assert all(start > end for start, end in zip(spans[0][1:], spans[1][:-1]))
+    # the path passes through every drawn pose's root
+    for root in roots:
+        assert np.min(np.linalg.norm(path - root, axis=1)) < 1e-9

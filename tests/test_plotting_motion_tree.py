@@ -59,3 +59,42 @@ def test_layer_figure_explains_sizes_colours_and_lines(model):
     spreads = ax.collections[0].get_array()
     low, high = ax.collections[0].get_clim()
     assert low == pytest.approx(spreads.min()) and high == pytest.approx(spreads.max())
+
+
+def _training_frames():
+    data = make_motions(n_clips_per_class=3, classes=["walk", "jump", "squat"], random_state=0)
+    clips = [c[:, 6:] for c in data.clips]
+    labels = np.repeat(data.target_names[data.target], [len(c) for c in clips])
+    return clips, labels
+
+
+def test_nodes_take_the_colour_of_most_of_their_frames(model):
+    clips, labels = _training_frames()
+    frames = (np.vstack(clips) - model.center_) / model.scale_
+    ax = plotting.plot_motion_tree_layer(model.tree_, layer=3, frames=frames, labels=labels)
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend[2:5] == ["jump", "squat", "walk"]
+    palette = matplotlib.colormaps["tab10"]
+    nodes = model.tree_.apply(frames, 3)
+    colours = ax.collections[0].get_facecolors()
+    for node in range(int(model.n_nodes_[3])):  # the majority label, counted by hand
+        mine = labels[nodes == node]
+        if len(mine):
+            names, counts = np.unique(mine, return_counts=True)
+            k = ["jump", "squat", "walk"].index(names[counts.argmax()])
+            np.testing.assert_allclose(colours[node][:3], palette(k)[:3])
+
+
+def test_an_outlying_node_does_not_squash_the_others():
+    clips, _ = _training_frames()
+    far = clips[0].copy()
+    far[:10] += 1e4  # ten frames far from everything: a node of their own
+    model = MotionTreeHMM(max_depth=5, min_samples_leaf=2).fit([far, *clips[1:]], np.arange(9) // 3)
+    tree = model.tree_
+    xy = (tree.means(-1) - tree.mean[0]) @ tree.principal_axes[[0, 1]].T
+    ax = plotting.plot_motion_tree_layer(tree, layer=-1)
+    low, high = ax.get_xlim()
+    inside = (xy[:, 0] >= low) & (xy[:, 0] <= high)
+    assert (~inside).sum() >= 1 and "off the view" in ax.get_title()
+    # the others spread over the view rather than crowding one end of it
+    assert np.ptp(xy[inside, 0]) > 0.1 * (high - low)  # all of them: < 1e-3

@@ -9,7 +9,10 @@ _MEDIA = {".png": "image/png", ".gif": "image/gif"}
 
 _STYLE = (
     "body{font-family:sans-serif;max-width:60em;margin:2em auto;padding:0 1em}"
-    "pre{background:#f6f6f6;padding:.8em;overflow-x:auto;font-size:90%}"
+    # pre-wrap: long lines (error messages, paths) wrap at the window's edge instead of being
+    # cut off, while the spaces that align tables are kept
+    "pre{background:#f6f6f6;padding:.8em;font-size:90%;white-space:pre-wrap;"
+    "overflow-wrap:anywhere}"
     "figure{margin:1em 0}img{max-width:100%}figcaption{font-size:90%;color:#444}"
 )
 

@@ -149,8 +149,8 @@ def choose_evaluation(labels, groups, subject_names=None, *, random_state=0, max
     more = f" and {len(lone) - 3} more" if len(lone) > 3 else ""
     why = (
         f"not by subject, because some classes have one subject only: {who}{more}"
-        if lone
-        else "not by subject: the clips come from one subject"
+        if lone and len(np.unique(groups)) > 1
+        else "not by subject: the clips come from one subject (or the subjects are unknown)"
     )
     n_splits = int(min(max_splits, counts[counts >= 2].min()))
     cv = StratifiedKFold(n_splits, shuffle=True, random_state=random_state)

@@ -1,13 +1,17 @@
 """Demo section (``skmotion demo --data FOLDER``): real motion files instead of synthetic data.
 
-Labels come from the CMU index wherever a file's name is a CMU trial (``02_01.amc``,
-``07_05.bvh``, at any depth): the trial's description mapped to a motion class by the
-keyword table of :mod:`skmotion.datasets._cmu_labels`. Other files are labelled by a
-keyword in their own name, and only then by their folder's name; the report counts each.
+Labels come from a labels file when one is given (``--labels``). Otherwise from the CMU
+index wherever a file's name is a CMU trial (``02_01.amc``, ``07_05.bvh``, at any depth):
+the trial's description mapped to a motion class by the keyword table of
+:mod:`skmotion.datasets._cmu_labels`. Other files are labelled by a keyword in their own
+name, and only then by their folder's name; the report counts each. Where folder-name
+labels look like the subjects (:func:`skmotion.datasets._labels.subject_confound`), no
+classifier is scored: its accuracy would measure telling people apart.
 """
 
 import inspect
 import re
+import warnings
 from collections import Counter
 from pathlib import Path
 
@@ -16,15 +20,17 @@ from sklearn.neighbors import KNeighborsClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.utils import Bunch
 
-from skmotion._demo._split import choose_evaluation
+from skmotion._demo._split import Evaluation, choose_evaluation
 from skmotion._demo.data import body_figures
 from skmotion.datasets import (
     cmu_motion_class,
     load_motion_folder,
     motion_class_of_name,
     read_cmu_index,
+    read_labels,
 )
-from skmotion.io import file_format
+from skmotion.datasets._labels import match_labels, subject_confound, subject_level
+from skmotion.io import file_format, folder_suffixes, read_ts
 from skmotion.kinematics import LAYOUTS, get_layout
 from skmotion.preprocessing import FlattenClips, ResampleClips, resample_clip, to_markers
 
@@ -49,22 +55,35 @@ def find_cmu_index(folder):
     return None
 
 
-def label_clips(filenames, root, index):
+def label_clips(filenames, root, index, table=None):
     """Label, label source and subject of every file.
 
     Returns
     -------
     labels, sources, subjects : lists of str
-        ``sources`` holds "CMU index", "file name" or "folder name" per file.
+        ``sources`` holds "labels file", "CMU index", "file name" or "folder name" per file.
     """
+    level = subject_level(filenames, root)
+    given_labels, given_subjects = (
+        match_labels(filenames, root, table, where="--labels") if table else (None, None)
+    )
     labels, sources, subjects = [], [], []
-    for name in filenames:
+    for k, name in enumerate(filenames):
         path = Path(name)
-        folder = path.parent.relative_to(root).as_posix() if path.parent != root else root.name
+        parts = path.parent.relative_to(root).parts
+        folder = "/".join(parts) or root.name
         match = _TRIAL.match(path.stem)
         trial = f"{int(match.group(1)):02d}_{int(match.group(2)):02d}" if match else None
-        subjects.append(trial.split("_")[0] if trial else folder)
-        if index is not None and trial in index.index:
+        subject = given_subjects[k] if table else None
+        if subject is None:
+            subject = (
+                trial.split("_")[0] if trial else parts[level] if level is not None else folder
+            )
+        subjects.append(subject)
+        if table:
+            labels.append(given_labels[k])
+            sources.append("labels file")
+        elif index is not None and trial in index.index:
             labels.append(cmu_motion_class(index.loc[trial, "description"]))
             sources.append("CMU index")
         elif motion_class_of_name(path.stem):
@@ -76,8 +95,32 @@ def label_clips(filenames, root, index):
     return labels, sources, subjects
 
 
-def _load(folder, index_path, verbose):
-    """The loader's Bunch, with a one-line DemoDataError for anything that stops it."""
+def subjects_known(filenames, root, table):
+    """Whether the subjects come from elsewhere than the label folders (file, CMU name, level)."""
+    if table and any(subject for _, subject in table.values()):
+        return True
+    if subject_level(filenames, root) is not None:
+        return True
+    return any(_TRIAL.match(Path(f).stem) for f in filenames)
+
+
+def confound_refusal(filenames, root, labels, sources, subjects, table):
+    """The sentence refusing to score folder-name labels that look like subjects, or None."""
+    stems = [Path(f).stem for f in filenames]
+    known = subjects_known(filenames, root, table)
+    reason = subject_confound(labels, sources, subjects, known, stems)
+    if reason is None:
+        return None
+    return (
+        f"NOT EVALUATED: the labels come from folder names, and {reason}; the classes are then "
+        "probably the subjects, and an accuracy would measure telling people apart, not "
+        "recognising motions. Give the labels with --labels FILE (a CSV with columns "
+        "path,label and optionally subject; path relative to the folder, or a file name)"
+    )
+
+
+def _load(folder, index_path, verbose, labels_path=None, layout=None, frame_rate=None):
+    """The loader's Bunch and its warnings, with a one-line DemoDataError for what stops it."""
     folder = Path(folder)
     if not folder.exists():
         raise DemoDataError(f"no folder at {folder}")
@@ -86,11 +129,22 @@ def _load(folder, index_path, verbose):
     options = {"index": index_path}
     if "verbose" in inspect.signature(load_motion_folder).parameters:
         options["verbose"] = verbose  # progress of the loader, where it offers it
+    if layout is not None:
+        options.update(layout=layout, frame_rate=frame_rate)
+    if labels_path is not None:
+        options["labels"] = labels_path  # so that the loader reads no labels file as keypoints
     try:
-        return load_motion_folder(folder, **options)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", UserWarning)
+            data = load_motion_folder(folder, **options)
     except (OSError, ValueError) as exc:
         message = " ".join(str(exc).split())
         raise DemoDataError(f"{folder}: {message}") from None
+    # The demo decides on labels itself; it reports the skipped files and the layout check.
+    notes = [
+        str(w.message) for w in caught if "the labels come from folder names" not in str(w.message)
+    ]
+    return data, notes
 
 
 def to_rate(clip, frame_rate, target_rate):
@@ -109,7 +163,9 @@ def _unwrapped(motion):
     return channels
 
 
-def _label_lines(sources, index_path):
+def _label_lines(sources, index_path, labels_path=None):
+    if labels_path is not None:
+        return [f"labels: all {len(sources)} clips from the labels file {labels_path}"]
     counts = {k: sources.count(k) for k in ("CMU index", "file name", "folder name")}
     index_text = f" ({index_path})" if index_path else " (none found in or above the folder)"
     return [
@@ -142,15 +198,117 @@ def _figure_lines(context, motions, filenames, labels):
     return body_figures(context, motion.channels, body, motion.frame_rate, what)
 
 
+def _keep_skeleton_motions(data):
+    """Leave out position files among skeleton files (no shared features), saying which."""
+    kept = [k for k, m in enumerate(data.motions) if m.skeleton is not None]
+    if not 0 < len(kept) < len(data.motions):
+        return []
+    left = [Path(f).name for k, f in enumerate(data.filenames) if k not in set(kept)]
+    data.motions = [data.motions[k] for k in kept]
+    data.skeletons = [data.skeletons[k] for k in kept]
+    data.filenames = data.filenames[kept]
+    return [
+        f"left out {len(left)} files of marker or joint positions among the skeleton files (the "
+        f"skeletons' virtual markers and the files' markers share no features): {', '.join(left)}"
+    ]
+
+
+def _series_folder(folder):
+    """The ``.ts`` files under ``folder`` when it holds no motion file, else None."""
+    folder = Path(folder)
+    if not folder.is_dir():
+        return None
+    files = sorted(p for p in folder.rglob("*") if p.is_file())
+    motion = set(folder_suffixes())
+    if any(p.suffix.lower() in motion for p in files):
+        return None
+    return [p for p in files if p.suffix.lower() == ".ts"] or None
+
+
+def _run_series(context, files):
+    """The demo's data from UEA/sktime ``.ts`` files: labelled series, no body, no subjects."""
+    clips, labels, sources = [], [], []
+    for path in files:
+        try:
+            series, named = read_ts(path)
+        except (OSError, ValueError) as exc:
+            raise DemoDataError(" ".join(str(exc).split())) from None
+        if named is None:
+            raise DemoDataError(f"{path}: the series have no class labels (@classLabel false)")
+        clips += [np.asarray(c, dtype=float) for c in series]
+        labels += [str(v) for v in named]
+        sources += [path.name] * len(series)
+    widths = {}
+    for clip, source in zip(clips, sources):
+        widths.setdefault(clip.shape[1], source)
+    if len(widths) > 1:
+        raise DemoDataError(
+            f"{context.data_folder}: the .ts files hold series of different dimensions ("
+            + ", ".join(f"{w} in {name}" for w, name in widths.items())
+            + "): give a folder of one data set"
+        )
+    target_names, target = np.unique(np.asarray(labels, dtype=object), return_inverse=True)
+    # .ts files record no performer: one unknown subject, so no subject-wise split is claimed.
+    groups = np.zeros(len(clips), dtype=int)
+    subject_names = np.asarray(["(unknown)"], dtype=object)
+    context.data = Bunch(
+        clips=clips, target=target, target_names=target_names, groups=groups,
+        subject_names=subject_names, frame_rate=float(getattr(context, "frame_rate", 30.0)),
+        motions=None, skeletons=[None] * len(clips), skeleton=None, layout=None, kind="series",
+        feature_names=[f"dim_{k}" for k in range(clips[0].shape[1])],
+        filenames=np.asarray(sources, dtype=object), label_sources=["file"] * len(clips),
+        DESCR=f"Labelled time series of {', '.join(p.name for p in files)}.",
+    )  # fmt: skip
+    evaluation = choose_evaluation(
+        target_names[target], groups, subject_names, random_state=context.random_state
+    )
+    context.evaluation = evaluation
+    lengths = np.array([len(c) for c in clips])
+    lines = [
+        f"{context.data_folder}: {len(clips)} labelled series in {len(files)} .ts files "
+        f"({', '.join(p.name for p in files)}), the files' train/test split pooled",
+        f"channels: {clips[0].shape[1]} dimensions (time series: no body, so the body figures, "
+        "virtual markers and planning are not run); length "
+        f"min {lengths.min()}, median {int(np.median(lengths))}, max {lengths.max()} frames",
+        "classes ("
+        + f"{len(target_names)}): "
+        + ", ".join(f"{n} {c}" for n, c in zip(target_names, np.bincount(target))),
+        "subjects: not recorded in .ts files",
+        f"evaluation: {evaluation.reason}",
+    ]
+    if evaluation.kind is None:
+        return lines
+    baseline = make_pipeline(ResampleClips(n_frames=32), FlattenClips(), KNeighborsClassifier(1))
+    scores = evaluation.scores(baseline, clips, target, verbose=context.verbose)
+    context.baseline_accuracy = scores.mean()
+    return lines + [
+        f"baseline, 1-NN on resampled clips, {evaluation.name}: "
+        f"accuracy {scores.mean():.3f} +/- {scores.std():.3f}"
+    ]
+
+
 def run(context):
+    series = _series_folder(context.data_folder)
+    if series is not None and getattr(context, "layout", None) is None:
+        return _run_series(context, series)
     rate = float(getattr(context, "frame_rate", None) or 30.0)
     verbose = getattr(context, "verbose", 0)
     index_path = getattr(context, "index", None) or find_cmu_index(context.data_folder)
-    data = _load(context.data_folder, index_path, verbose)
+    labels_path, layout = getattr(context, "labels", None), getattr(context, "layout", None)
+    try:
+        table = read_labels(labels_path) if labels_path else None
+    except (OSError, ValueError) as exc:
+        raise DemoDataError(f"--labels {labels_path}: {exc}") from None
+    data, notes = _load(context.data_folder, index_path, verbose, labels_path, layout, rate)
+    notes += _keep_skeleton_motions(data)
     index = read_cmu_index(index_path) if index_path else None
     root = Path(context.data_folder).resolve()
     files = [Path(f).resolve() for f in data.filenames]
-    labels, sources, subjects = label_clips(files, root, index)
+    try:
+        labels, sources, subjects = label_clips(files, root, index, table)
+    except ValueError as exc:
+        raise DemoDataError(str(exc)) from None
+    refusal = confound_refusal(files, root, labels, sources, subjects, table)
     target_names, target = np.unique(np.asarray(labels, dtype=object), return_inverse=True)
     subject_names, groups = np.unique(np.asarray(subjects, dtype=object), return_inverse=True)
     motions = data.motions
@@ -196,6 +354,8 @@ def run(context):
     evaluation = choose_evaluation(
         target_names[target], groups, subject_names, random_state=context.random_state
     )
+    if refusal is not None:
+        evaluation = Evaluation(None, None, evaluation.clips, refusal, groups, subject_names)
     context.evaluation = evaluation
     lengths = np.array([len(c) for c in clips])
     rates = sorted({m.frame_rate for m in motions})
@@ -209,7 +369,7 @@ def run(context):
         f"resampled to {rate:g} Hz: {lengths.sum():,} frames ({lengths.sum() / rate:.1f} s); "
         f"clip length min {lengths.min()}, median {int(np.median(lengths))}, max {lengths.max()}",
         f"channels: {len(feature_names)} {kind}",
-        *_label_lines(sources, index_path),
+        *_label_lines(sources, index_path, labels_path),
         f"classes ({len(target_names)}): "
         + ", ".join(
             f"{name} {n} ({len(np.unique(groups[target == k]))} subj.)"
@@ -219,6 +379,7 @@ def run(context):
         + ", ".join(f"{name} {n}" for name, n in zip(subject_names, np.bincount(groups))),
         f"evaluation: {evaluation.reason}",
     ]
+    lines[1:1] = [f"warning: {' '.join(note.split())}" for note in notes]
     if evaluation.kind is None:
         lines.append("baseline: not run (no split can evaluate a classifier)")
         return lines + _figure_lines(context, motions, data.filenames, target_names[target])

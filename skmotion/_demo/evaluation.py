@@ -62,7 +62,8 @@ def _nested(context, clips, y, groups):
 
 def run(context):
     data = context.data
-    clips = [c[:, 6:] for c in data.clips]  # without the root's (or pelvis marker's) channels
+    # without the root's (or pelvis marker's) channels; time series have no root
+    clips = data.clips if data.get("kind") == "series" else [c[:, 6:] for c in data.clips]
     y, groups = np.asarray(data.target), np.asarray(data.groups)
     evaluation = evaluation_of(context)
     n_subjects = len(np.unique(groups))

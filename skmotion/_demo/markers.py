@@ -27,6 +27,8 @@ TITLE = "Virtual markers: positions and velocities in the body frame"
 def _markers(context):
     """Body-frame marker clips, their names and how they were placed (or why they cannot be)."""
     data = context.data
+    if data.get("kind") == "series":
+        return None, None, "labelled time series have no body to place markers on"
     motions = data.get("motions")
     if motions and all(m.skeleton is None for m in motions):  # joint positions, no skeleton
         if data.layout is None:

@@ -1,25 +1,38 @@
 """Datasets: the built-in synthetic motions and humanoid skeleton; loaders of real data."""
 
-from skmotion.datasets._cmu_labels import CMU_MOTION_CLASSES, cmu_motion_class, motion_class_of_name
-from skmotion.datasets._fetch import fetch_cmu_mocap
-from skmotion.datasets._home import get_data_home
-from skmotion.datasets._humanoid import humanoid_skeleton
-from skmotion.datasets._motion_files import (
-    load_bvh_folder,
-    load_cmu_asfamc,
-    load_motion_folder,
-    read_cmu_index,
+from skmotion._lazy import attach
+
+__getattr__, __dir__ = attach(
+    __name__,
+    {
+        "skmotion.datasets._cmu_labels": [
+            "CMU_MOTION_CLASSES",
+            "cmu_motion_class",
+            "motion_class_of_name",
+        ],
+        "skmotion.datasets._fetch": ["fetch_cmu_mocap"],
+        "skmotion.datasets._home": ["get_data_home"],
+        "skmotion.datasets._humanoid": ["humanoid_skeleton"],
+        "skmotion.datasets._labels": ["read_labels"],
+        "skmotion.datasets._motion_files": [
+            "load_bvh_folder",
+            "load_cmu_asfamc",
+            "load_motion_folder",
+            "read_cmu_index",
+            "read_labels",
+        ],
+        "skmotion.datasets._positions": [
+            "EXTRA_LANDMARKS",
+            "layout_markers",
+            "layout_positions",
+            "make_position_motions",
+        ],
+        "skmotion.datasets._repeats": ["make_repeated_motions"],
+        "skmotion.datasets._synthetic": ["MOTION_CLASSES", "make_motions"],
+        "skmotion.datasets._uea": ["load_uea"],
+        "skmotion.datasets._walks": ["WALK_DIRECTIONS", "make_walks"],
+    },
 )
-from skmotion.datasets._positions import (
-    EXTRA_LANDMARKS,
-    layout_markers,
-    layout_positions,
-    make_position_motions,
-)
-from skmotion.datasets._repeats import make_repeated_motions
-from skmotion.datasets._synthetic import MOTION_CLASSES, make_motions
-from skmotion.datasets._uea import load_uea
-from skmotion.datasets._walks import WALK_DIRECTIONS, make_walks
 
 __all__ = [
     "CMU_MOTION_CLASSES",
@@ -42,4 +55,5 @@ __all__ = [
     "make_walks",
     "motion_class_of_name",
     "read_cmu_index",
+    "read_labels",
 ]

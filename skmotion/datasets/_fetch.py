@@ -237,7 +237,9 @@ def fetch_cmu_mocap(
     root = get_data_home(data_home) / "cmu-asfamc"
     for subject in progress(subjects, verbose=verbose, desc="CMU subjects"):
         _fetch_subject(root, subject, trials, index, timeout, verify, verbose)
-    data = load_cmu_asfamc(root, index, subjects=subjects)
+    data = load_cmu_asfamc(
+        root, index, subjects=subjects, errors="raise"
+    )  # a bad cache is an error
     if trials is not None:
         keep = np.isin([int(t.split("_")[1]) for t in data.trials], trials)
         data = _select(data, np.flatnonzero(keep))
@@ -289,7 +291,7 @@ def _select(data, rows):
     """The Bunch restricted to some clips."""
     picked = {}
     for key, value in data.items():
-        if isinstance(value, list):
+        if isinstance(value, list) and key != "skipped":  # skipped: files, not clips
             picked[key] = [value[i] for i in rows]
         elif isinstance(value, np.ndarray) and key not in ("target_names", "subject_names"):
             picked[key] = value[rows]

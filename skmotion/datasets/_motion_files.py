@@ -1,17 +1,21 @@
 """Loading folders of motion files: the formats of ``skmotion.io.FORMATS`` that folders hold."""
 
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from sklearn.utils import Bunch
 
+from skmotion.datasets._labels import match_labels, read_labels, subject_confound, subject_level
 from skmotion.io import FORMATS, file_format, folder_suffixes
 from skmotion.utils import progress
 
 __all__ = ["load_bvh_folder", "load_cmu_asfamc", "load_motion_folder", "read_cmu_index"]
 
+#: Keypoint files (joint positions per frame), read from folders with ``layout=``.
+KEYPOINT_SUFFIXES = (".npy", ".npz", ".csv", ".txt")
 _TRIAL = re.compile(r"^(\d+)_(\d+)$")
 _INDEX_COLUMNS = ("Subject", "Trial #", "Motion Description")
 
@@ -111,27 +115,54 @@ def _find_files(folder, suffixes):
     return [(file_format(p), p) for p in paths]
 
 
-def _read_files(files, index, options, verbose):
-    """Every (motion, path) of ``files``; a skeleton file is read once for all its motions."""
+def _read_one(row, path, index, options, skeletons):
+    """The motion of one file; a skeleton file is read once for all its motions."""
+    if row.skeleton_suffix is None:
+        return row.reader(path, **options.get(row.suffix, {}))
+    skeleton_path = _skeleton_for(path, row.skeleton_suffix)
+    if skeleton_path not in skeletons:
+        skeletons[skeleton_path] = file_format(skeleton_path).reader(skeleton_path)
+    trial = _trial_id(path.stem)
+    rate = 120.0  # CMU's rate; AMC files do not record theirs
+    if index is not None and trial in index.index and np.isfinite(index.loc[trial, "frame_rate"]):
+        rate = float(index.loc[trial, "frame_rate"])
+    return row.reader(path, skeletons[skeleton_path], frame_rate=rate)
+
+
+# What a damaged or unreadable file raises (MotionFileError is a ValueError; a missing
+# skeleton an OSError; a missing optional reader an ImportError).
+_FILE_ERRORS = (OSError, ValueError, ImportError, EOFError)
+
+
+def _read_files(files, index, options, verbose, errors="skip"):
+    """Every (motion, path) of ``files`` that reads, and (path, reason) of those that do not."""
     skeletons = {}
-    out = []
+    out, skipped = [], []
     for row, path in progress(files, verbose=verbose, desc="reading motion files"):
-        if row.skeleton_suffix is None:
-            out.append((row.reader(path, **options.get(row.suffix, {})), path))
-            continue
-        skeleton_path = _skeleton_for(path, row.skeleton_suffix)
-        if skeleton_path not in skeletons:
-            skeletons[skeleton_path] = file_format(skeleton_path).reader(skeleton_path)
-        trial = _trial_id(path.stem)
-        rate = 120.0  # CMU's rate; AMC files do not record theirs
-        if (
-            index is not None
-            and trial in index.index
-            and np.isfinite(index.loc[trial, "frame_rate"])
-        ):
-            rate = float(index.loc[trial, "frame_rate"])
-        out.append((row.reader(path, skeletons[skeleton_path], frame_rate=rate), path))
-    return out
+        try:
+            out.append((_read_one(row, path, index, options, skeletons), path))
+        except _FILE_ERRORS as exc:
+            if errors == "raise" or len(files) == 1:
+                raise
+            skipped.append((str(path), " ".join(str(exc).split()) or type(exc).__name__))
+    return out, skipped
+
+
+def _report_skipped(entries, skipped, folder):
+    """A warning naming every skipped file; an error when no file at all could be read."""
+    if not skipped:
+        return
+    listed = "\n  ".join(f"{path}: {reason}" for path, reason in skipped)
+    if not entries:
+        raise ValueError(
+            f"None of the {len(skipped)} motion files under {folder} could be read:\n  {listed}"
+        )
+    warnings.warn(
+        f"Skipped {len(skipped)} of {len(skipped) + len(entries)} motion files under {folder} "
+        f"that could not be read (the others are loaded):\n  {listed}",
+        UserWarning,
+        stacklevel=3,
+    )
 
 
 def _check_layouts(entries, folder, channel_layouts):
@@ -158,19 +189,66 @@ def _check_layouts(entries, folder, channel_layouts):
     return layout, layouts
 
 
-def _bunch(entries, root, index, descr, channel_layouts="any"):
+def _folder_of(path, root, level):
+    """A file's folder below ``root`` as a label, without the folder level that names people."""
+    parts = list(path.parent.relative_to(root).parts)
+    if level is not None and len(parts) > 1:
+        del parts[level]
+    return "/".join(parts) or root.name
+
+
+def _labels(paths, root, index, table):
+    """Per file: label, its source, subject, and whether the subjects come from elsewhere."""
+    trials = [_trial_id(p.stem) for p in paths]
+    level = subject_level(paths, root)
+    known = [index is not None and t in index.index for t in trials]
+    descriptions = [index.loc[t, "description"] if k else "" for t, k in zip(trials, known)]
+    given = [None] * len(paths)
+    if table is not None:
+        labels, given = match_labels(paths, root, table)
+        sources = ["labels file"] * len(paths)
+    else:
+        labels = [
+            _short_label(d) if d else _folder_of(p, root, level)
+            for d, p in zip(descriptions, paths)
+        ]
+        sources = ["CMU index" if d else "folder name" for d in descriptions]
+    subjects, subjects_known = [], level is not None
+    for path, trial, subject in zip(paths, trials, given):
+        parts = path.parent.relative_to(root).parts
+        subjects_known |= subject is not None or trial is not None
+        if subject is None and trial is None and level is None:
+            subject = parts[0] if parts else root.name  # unknown: the top folder stands in
+        subjects.append(subject or (trial.split("_")[0] if trial else parts[level]))
+    return labels, sources, subjects, subjects_known, descriptions, trials
+
+
+def confound_warning(folder, labels, sources, subjects, subjects_known, paths):
+    """The loud sentence when folder-name labels look like the subjects, or None."""
+    reason = subject_confound(
+        labels, sources, subjects, subjects_known, [Path(p).stem for p in paths]
+    )
+    if reason is None:
+        return None
+    return (
+        f"{folder}: the labels come from folder names, and {reason}. The classes are then "
+        "probably the people, and a classifier's score measures telling subjects apart, not "
+        "recognising motions. Give the labels in a CSV file (columns path,label[,subject]): "
+        "labels= here, --labels on the command line."
+    )
+
+
+def _bunch(entries, root, index, descr, channel_layouts="any", table=None, skipped=()):
     """The Bunch of a list of (motion, path)."""
     layout, layouts = _check_layouts(entries, root, channel_layouts)
     motions = [m for m, _ in entries]
     paths = [p for _, p in entries]
-    trials = [_trial_id(p.stem) for p in paths]
-    folders = [
-        p.parent.relative_to(root).as_posix() if p.parent != root else root.name for p in paths
-    ]
-    known = [index is not None and t in index.index for t in trials]
-    descriptions = [index.loc[t, "description"] if k else "" for t, k in zip(trials, known)]
-    labels = [_short_label(d) if k and d else f for d, k, f in zip(descriptions, known, folders)]
-    subjects = [t.split("_")[0] if t else f for t, f in zip(trials, folders)]
+    labels, sources, subjects, subjects_known, descriptions, trials = _labels(
+        paths, root, index, table
+    )
+    warning = confound_warning(root, labels, sources, subjects, subjects_known, paths)
+    if warning is not None:
+        warnings.warn(warning, UserWarning, stacklevel=3)
     target_names, target = np.unique(np.asarray(labels, dtype=object), return_inverse=True)
     subject_names, groups = np.unique(np.asarray(subjects, dtype=object), return_inverse=True)
     rates = {m.frame_rate for m in motions}
@@ -188,6 +266,9 @@ def _bunch(entries, root, index, descr, channel_layouts="any"):
         frame_rate=rates.pop() if len(rates) == 1 else None,
         layout=layout,
         layout_channels=tuple(layouts),
+        label_source=np.asarray(sources, dtype=object),
+        label_warning=warning,
+        skipped=list(skipped),
         DESCR=descr,
     )
 
@@ -215,6 +296,7 @@ _BUNCH_DOC = """
             Label index per clip: the CMU description up to its first comma
             or dash when the index knows the trial, else the clip's subfolder.
         target_names : ndarray of str
+            The distinct labels, sorted.
         groups : ndarray of int
             Subject per clip (the ``NN`` of a CMU ``NN_TT`` file name, else the
             subfolder), for ``GroupKFold``; names in ``subject_names``.
@@ -225,10 +307,16 @@ _BUNCH_DOC = """
         layout : ndarray of int
             Per clip, its channel layout: an index into ``layout_channels``,
             the distinct tuples of channel names (one when every clip has the
-            same channels)."""
+            same channels).
+        label_source : ndarray of str
+            Per clip: ``"labels file"``, ``"CMU index"`` or ``"folder name"``.
+        label_warning : str or None
+            Why the folder-name labels may be the subjects (also warned).
+        skipped : list of (str, str)
+            The files that could not be read, and why."""
 
 
-def load_cmu_asfamc(folder, index=None, *, subjects=None, verbose=0):
+def load_cmu_asfamc(folder, index=None, *, subjects=None, errors="skip", verbose=0):
     """Load CMU-style Acclaim data: one folder per subject with ``NN.asf`` and ``NN_TT.amc``.
 
     Parameters
@@ -241,6 +329,8 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None, verbose=0):
         rates; without it every trial is taken at 120 Hz.
     subjects : list of int, default=None
         Only these subjects.
+    errors : {"skip", "raise"}, default="skip"
+        Skip a file that cannot be read (with a warning naming it), or raise.
     verbose : int, default=0
         Report progress over the files on standard error when >= 1.
 
@@ -264,21 +354,26 @@ def load_cmu_asfamc(folder, index=None, *, subjects=None, verbose=0):
     for sub in sorted(p for p in folder.iterdir() if p.is_dir()):
         if wanted is None or (sub.name.isdigit() and int(sub.name) in wanted):
             files += _find_files(sub, (".amc",))
-    entries = _read_files(files, index, {}, verbose)
-    if not entries:
+    if not files:
         raise FileNotFoundError(f"No .amc trials under {folder} (expected one folder per subject).")
-    return _bunch(
-        entries, folder, index, "CMU Graphics Lab Motion Capture Database, Acclaim ASF/AMC."
-    )
+    entries, skipped = _read_files(files, index, {}, verbose, errors)
+    _report_skipped(entries, skipped, folder)
+    descr = "CMU Graphics Lab Motion Capture Database, Acclaim ASF/AMC."
+    return _bunch(entries, folder, index, descr, skipped=skipped)
 
 
-def load_bvh_folder(folder, *, up_axis=None, channel_layouts="same", verbose=0):
+def load_bvh_folder(folder, *, labels=None, up_axis=None, channel_layouts="same", verbose=0):
     """Load every ``.bvh`` file under a folder (recursively), labelled by subfolder.
 
     Parameters
     ----------
     folder : str or path-like
-        The folder; ``folder/walk/a.bvh`` gets the label ``"walk"``.
+        The folder; ``folder/walk/a.bvh`` gets the label ``"walk"``. A file
+        that cannot be read is skipped with a warning naming it.
+    labels : str, path-like or dict, default=None
+        A labels file (:func:`read_labels`) instead of the folder names; the
+        loader warns when folder names look like subjects (see
+        :func:`load_motion_folder`).
     up_axis : {"x", "y", "z"}, default=None
         Passed to :func:`skmotion.io.read_bvh` (None: detected per file).
     channel_layouts : {"same", "any"}, default="same"
@@ -314,16 +409,39 @@ def load_bvh_folder(folder, *, up_axis=None, channel_layouts="same", verbose=0):
     files = _find_files(folder, (".bvh",))
     if not files:
         raise FileNotFoundError(f"No .bvh files under {folder}.")
-    entries = _read_files(files, None, {".bvh": {"up_axis": up_axis}}, verbose)
-    return _bunch(entries, folder, None, f"BVH files under {folder}.", channel_layouts)
+    table = read_labels(labels) if isinstance(labels, (str, Path)) else labels
+    entries, skipped = _read_files(files, None, {".bvh": {"up_axis": up_axis}}, verbose)
+    _report_skipped(entries, skipped, folder)
+    descr = f"BVH files under {folder}."
+    return _bunch(entries, folder, None, descr, channel_layouts, table, skipped)
 
 
-def load_motion_folder(folder, index=None, *, channel_layouts="any", verbose=0):
-    """Load every motion file under a folder: BVH, ASF/AMC subject folders and C3D files.
+def load_motion_folder(
+    folder,
+    index=None,
+    *,
+    labels=None,
+    layout=None,
+    frame_rate=None,
+    channel_layouts="any",
+    errors="skip",
+    verbose=0,
+):
+    """Load every motion file under a folder: BVH, ASF/AMC subject folders, C3D, keypoint files.
 
     The formats are the rows of :data:`skmotion.io.FORMATS` marked
     ``in_folders`` (:func:`skmotion.io.folder_suffixes`); suffixes match in
-    any case. Reading ``.c3d`` files needs the ``c3d`` extra.
+    any case. Reading ``.c3d`` files needs the ``c3d`` extra. With
+    ``layout=``, keypoint files (``.npy``, ``.npz``, ``.csv``, ``.txt``:
+    joint positions per frame, see :func:`skmotion.io.read_keypoints`) are
+    read too, in that layout's joint order, and the order is checked against
+    the data (:func:`skmotion.kinematics.check_layout`): a warning names the
+    joints that do not fit.
+
+    A file that cannot be read is skipped with a warning naming it and the
+    reason; the others load. Labels come from a labels file when given, else
+    from the CMU index for CMU trials, else from the folder names; when those
+    folder names look like the subjects, a warning says so (see Notes).
 
     Parameters
     ----------
@@ -333,11 +451,25 @@ def load_motion_folder(folder, index=None, *, channel_layouts="any", verbose=0):
     index : str, path-like or DataFrame, default=None
         A CMU index CSV; by default one at the top of ``folder`` is used when
         present. Trials it knows are labelled by their description.
+    labels : str, path-like or dict, default=None
+        A labels file (:func:`read_labels`: CSV columns ``path``, ``label``
+        and optionally ``subject``) or its table; every file must be in it.
+    layout : str or Layout, default=None
+        The joint order of the folder's keypoint files (a name of
+        :data:`skmotion.kinematics.LAYOUTS` or a Layout). None reads no
+        keypoint files.
+    frame_rate : float, default=None
+        Frames per second of the keypoint files (they do not record it);
+        needed with ``layout``.
     channel_layouts : {"any", "same"}, default="any"
         ``"any"`` loads files of different skeletons and formats together
         (``layout`` tells each clip's channel layout; map them onto shared
         virtual markers with VirtualMarkerTransform); ``"same"`` refuses
         them, naming the files of each layout.
+    errors : {"skip", "raise"}, default="skip"
+        ``"skip"`` leaves out a file that cannot be read (listed in
+        ``skipped`` and in a warning); ``"raise"`` stops at it. A folder
+        where no file reads is an error either way.
     verbose : int, default=0
         Report progress over the files on standard error when >= 1.
 
@@ -346,23 +478,79 @@ def load_motion_folder(folder, index=None, *, channel_layouts="any", verbose=0):
     data : Bunch
         %(bunch)s
 
+    Notes
+    -----
+    Recordings are most often filed by person (``S01/trial1.bvh``). Labels
+    taken from such folders are the people, and a classifier scores well by
+    telling them apart. The loader warns when the folder-name labels look
+    like people (``S01``, ``sub-2``, ``07``), when the subjects are known
+    (CMU trial names, a folder level of person-like names) and each label
+    holds one of them. A folder level of person-like names (``S01/walk/a.bvh``) gives
+    the subjects, and the label is the rest of the path (``walk``).
+
     Examples
     --------
-    >>> from skmotion.datasets import load_motion_folder
-    >>> data = load_motion_folder("../shared/data")  # doctest: +SKIP
-    >>> data.target_names  # doctest: +SKIP
+    >>> import os, tempfile
+    >>> import numpy as np
+    >>> from skmotion.datasets import load_motion_folder, make_position_motions
+    >>> data = make_position_motions("kinect_v1", n_clips_per_class=2, classes=["walk", "wave"],
+    ...                              random_state=0)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     with open(os.path.join(folder, "labels.csv"), "w") as handle:
+    ...         _ = handle.write("file,label\\n")
+    ...         for k, clip in enumerate(data.clips):
+    ...             np.save(os.path.join(folder, f"take{k}.npy"), clip)
+    ...             _ = handle.write(f"take{k},{data.target_names[data.target[k]]}\\n")
+    ...     loaded = load_motion_folder(folder, labels=os.path.join(folder, "labels.csv"),
+    ...                                 layout="kinect_v1", frame_rate=30)
+    >>> loaded.target_names.tolist(), loaded.target.tolist(), loaded.clips[0].shape
+    (['walk', 'wave'], [0, 0, 1, 1], (88, 60))
     """
     folder = _check_folder(folder)
     if index is None:
         index = _find_index(folder)
+    not_data = {Path(p).resolve() for p in (index, labels) if isinstance(p, (str, Path))}
     index = _as_index(index)
+    table = read_labels(labels) if isinstance(labels, (str, Path)) else labels
     _check_choice(channel_layouts)
+    if errors not in ("skip", "raise"):
+        raise ValueError(f"errors must be 'skip' or 'raise'; got {errors!r}.")
     suffixes = folder_suffixes()
-    files = _find_files(folder, suffixes)
+    options = {}
+    if layout is not None:
+        if frame_rate is None:
+            raise ValueError("Keypoint files do not record their frame rate: pass frame_rate=.")
+        suffixes += KEYPOINT_SUFFIXES
+        options = {s: {"layout": layout, "frame_rate": frame_rate} for s in KEYPOINT_SUFFIXES}
+    files = [(r, p) for r, p in _find_files(folder, suffixes) if p.resolve() not in not_data]
     if not files:
         raise FileNotFoundError(f"No motion files ({', '.join(suffixes)}) under {folder}.")
-    entries = _read_files(files, index, {}, verbose)
-    return _bunch(entries, folder, index, f"Motion files under {folder}.", channel_layouts)
+    entries, skipped = _read_files(files, index, options, verbose, errors)
+    _report_skipped(entries, skipped, folder)
+    data = _bunch(
+        entries, folder, index, f"Motion files under {folder}.", channel_layouts, table, skipped
+    )
+    if layout is not None:
+        _warn_layout(data, layout, folder)
+    return data
+
+
+def _warn_layout(data, layout, folder):
+    """A warning naming the joints when the keypoint clips do not fit ``layout``'s order."""
+    from skmotion.kinematics import check_layout, get_layout
+
+    layout = get_layout(layout)
+    width = layout.n_joints * layout.dim
+    clips = [m.channels for m in data.motions if m.skeleton is None and m.n_channels == width]
+    problems = check_layout(clips, layout) if clips else []
+    if problems:
+        warnings.warn(
+            f"{folder}: the data do not fit the joint order of layout {layout.name!r}: "
+            + "; ".join(problems)
+            + ". Is the order the one your tracker writes its joints in?",
+            UserWarning,
+            stacklevel=3,
+        )
 
 
 for _func in (load_cmu_asfamc, load_bvh_folder, load_motion_folder):

@@ -207,7 +207,8 @@ def make_position_motions(
     data : Bunch
         clips : list of ndarray of shape (n_frames_i, dim * n_joints)
             Joint positions, joint-major.
-        target, target_names, groups, frame_rate : as in :func:`make_motions`.
+        target, target_names, groups, frame_rate
+            As in :func:`make_motions`.
         layout : Layout
             The layout of the clips.
         angles : list of ndarray

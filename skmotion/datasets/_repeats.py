@@ -87,6 +87,7 @@ def make_repeated_motions(
     -------
     data : Bunch
         clips : list of ndarray of shape (n_frames_i, 75) or (n_frames_i, 60)
+            Joint positions per frame.
         target : ndarray of shape (n_clips,)
             Motion id of each clip (``n_repeats`` clips per id).
         motion_class : ndarray of shape (n_clips,)
@@ -98,6 +99,7 @@ def make_repeated_motions(
         feature_names : list of str
             Channel names.
         frame_rate : float
+            Frames per second.
 
     Examples
     --------

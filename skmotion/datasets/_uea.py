@@ -34,6 +34,7 @@ def load_uea(name_or_path, *, subset="all", data_home=None):
     -------
     data : Bunch
         clips : list of ndarray of shape (n_frames_i, n_dimensions)
+            One clip per series.
         target : ndarray of str
             The class label of each clip.
         target_names : ndarray of str
@@ -41,6 +42,7 @@ def load_uea(name_or_path, *, subset="all", data_home=None):
         subset : ndarray of str
             ``"train"`` or ``"test"`` per clip.
         name : str
+            The data set's name.
         frame_rate : None
             The archive does not record sampling rates.
 

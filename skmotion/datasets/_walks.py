@@ -137,6 +137,7 @@ def make_walks(
         target : ndarray of shape (n_clips,)
             Direction index of each clip, into ``target_names``.
         target_names : ndarray of str
+            The walking directions.
         root_velocity : list of ndarray of shape (n_frames_i, 3)
             Per frame, the hips' forward and leftward speed (m/s) in the
             facing frame and the yaw rate (rad/s, counter-clockwise from above).
@@ -145,6 +146,7 @@ def make_walks(
         skeleton : Skeleton
             The humanoid at scale 1.
         frame_rate : float
+            Frames per second.
 
     Examples
     --------

@@ -1,15 +1,22 @@
 """Reading and writing motion files."""
 
-from skmotion.io._amc import read_amc
-from skmotion.io._asf import acclaim_order, read_asf
-from skmotion.io._bvh import detect_up_axis, read_bvh
-from skmotion.io._bvh_write import write_bvh
-from skmotion.io._c3d import read_c3d
-from skmotion.io._errors import MotionFileError
-from skmotion.io._formats import FORMATS, FileFormat, file_format, folder_suffixes
-from skmotion.io._keypoints import read_keypoints
-from skmotion.io._motion import Motion, as_motions
-from skmotion.io._ts import read_ts
+from skmotion._lazy import attach
+
+__getattr__, __dir__ = attach(
+    __name__,
+    {
+        "skmotion.io._amc": ["read_amc"],
+        "skmotion.io._asf": ["acclaim_order", "read_asf"],
+        "skmotion.io._bvh": ["detect_up_axis", "read_bvh"],
+        "skmotion.io._bvh_write": ["write_bvh"],
+        "skmotion.io._c3d": ["read_c3d"],
+        "skmotion.io._errors": ["MotionFileError"],
+        "skmotion.io._formats": ["FORMATS", "FileFormat", "file_format", "folder_suffixes"],
+        "skmotion.io._keypoints": ["read_keypoints"],
+        "skmotion.io._motion": ["Motion", "as_motions"],
+        "skmotion.io._ts": ["read_ts"],
+    },
+)
 
 __all__ = [
     "FORMATS",

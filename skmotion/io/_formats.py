@@ -4,17 +4,11 @@
 command line read this table; adding a format is adding one row.
 """
 
+import importlib
 from dataclasses import dataclass
 from pathlib import Path
 
-from skmotion.io._amc import read_amc
-from skmotion.io._asf import read_asf
-from skmotion.io._bvh import read_bvh
-from skmotion.io._c3d import read_c3d
-from skmotion.io._keypoints import read_keypoints
-from skmotion.io._ts import read_ts
-
-__all__ = ["FORMATS", "FileFormat", "file_format", "folder_suffixes"]
+__all__ = ["FORMATS", "FileFormat", "file_format", "folder_suffixes", "formats_help"]
 
 KINDS = ("angles", "positions", "skeleton", "series")
 
@@ -33,8 +27,10 @@ class FileFormat:
         What a file holds: joint angles with a skeleton (a :class:`Motion`),
         point positions (a position :class:`Motion`), a skeleton only, or
         labelled time series.
-    reader : callable
-        The public reader: ``reader(path, ...)``.
+    reader_name : str
+        Where the public reader lives, ``"module:function"``; the
+        :attr:`reader` property imports it on first use, so that reading the
+        table (``skmotion --help``) imports no reader and no numpy.
     description : str
         One line for tables and help texts.
     extra : str, default=None
@@ -53,12 +49,18 @@ class FileFormat:
     suffix: str
     name: str
     kind: str
-    reader: object
+    reader_name: str
     description: str
     extra: str = None
     skeleton_suffix: str = None
     needs_frame_rate: bool = False
     in_folders: bool = False
+
+    @property
+    def reader(self):
+        """The public reader, ``reader(path, ...)``."""
+        module, name = self.reader_name.split(":")
+        return getattr(importlib.import_module(module), name)
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -71,44 +73,79 @@ class FileFormat:
 
 #: Every format skmotion reads, in the order tables list them.
 FORMATS = (
-    FileFormat(".bvh", "BVH", "angles", read_bvh, "skeleton and joint angles", in_folders=True),
+    FileFormat(
+        ".bvh",
+        "BVH",
+        "angles",
+        "skmotion.io._bvh:read_bvh",
+        "skeleton and joint angles",
+        in_folders=True,
+    ),
     FileFormat(
         ".amc",
         "Acclaim motion (AMC)",
         "angles",
-        read_amc,
+        "skmotion.io._amc:read_amc",
         "joint angles of an ASF skeleton (the CMU database)",
         skeleton_suffix=".asf",
         in_folders=True,
     ),
-    FileFormat(".asf", "Acclaim skeleton (ASF)", "skeleton", read_asf, "the skeleton of AMC files"),
+    FileFormat(
+        ".asf",
+        "Acclaim skeleton (ASF)",
+        "skeleton",
+        "skmotion.io._asf:read_asf",
+        "the skeleton of AMC files",
+    ),
     FileFormat(
         ".c3d",
         "C3D",
         "positions",
-        read_c3d,
+        "skmotion.io._c3d:read_c3d",
         "optical marker positions with residuals",
         extra="c3d",
         in_folders=True,
     ),
     FileFormat(
-        ".npy", "keypoint array", "positions", read_keypoints, "joint positions per frame",
+        ".npy",
+        "keypoint array",
+        "positions",
+        "skmotion.io._keypoints:read_keypoints",
+        "joint positions per frame",
         needs_frame_rate=True,
     ),
     FileFormat(
-        ".npz", "keypoint arrays", "positions", read_keypoints,
-        "joint positions per frame, confidences, joint names", needs_frame_rate=True,
+        ".npz",
+        "keypoint arrays",
+        "positions",
+        "skmotion.io._keypoints:read_keypoints",
+        "joint positions per frame, confidences, joint names",
+        needs_frame_rate=True,
     ),
     FileFormat(
-        ".csv", "keypoint table", "positions", read_keypoints,
-        "one frame per row, joint after joint", needs_frame_rate=True,
+        ".csv",
+        "keypoint table",
+        "positions",
+        "skmotion.io._keypoints:read_keypoints",
+        "one frame per row, joint after joint",
+        needs_frame_rate=True,
     ),
     FileFormat(
-        ".txt", "keypoint text", "positions", read_keypoints,
-        "x y z [confidence] per joint or per frame (Kinect recorders)", needs_frame_rate=True,
+        ".txt",
+        "keypoint text",
+        "positions",
+        "skmotion.io._keypoints:read_keypoints",
+        "x y z [confidence] per joint or per frame (Kinect recorders)",
+        needs_frame_rate=True,
     ),
-    FileFormat(".ts", "UEA/sktime time series (.ts)", "series", read_ts, "labelled time series"),
-)  # fmt: skip
+    FileFormat(
+        ".ts",
+        "UEA/sktime time series (.ts)",
+        "series",
+        "skmotion.io._ts:read_ts",
+        "labelled time series",
+    ),
+)
 
 
 def file_format(path):
@@ -156,3 +193,23 @@ def folder_suffixes():
     ('.bvh', '.amc', '.c3d')
     """
     return tuple(row.suffix for row in FORMATS if row.in_folders)
+
+
+def formats_help():
+    """One line per format of :data:`FORMATS`, for help texts.
+
+    Returns
+    -------
+    text : str
+
+    Examples
+    --------
+    >>> from skmotion.io._formats import formats_help
+    >>> print(formats_help().splitlines()[0])
+    .bvh  BVH: skeleton and joint angles
+    """
+    return "\n".join(
+        f"{row.suffix:<5} {row.name}: {row.description}"
+        + (f" (extra '{row.extra}')" if row.extra else "")
+        for row in FORMATS
+    )

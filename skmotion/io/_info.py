@@ -5,9 +5,9 @@ from pathlib import Path
 
 import numpy as np
 
-from skmotion.io._formats import FORMATS, file_format
+from skmotion.io._formats import FORMATS, file_format, formats_help
 
-__all__ = ["describe_file"]
+__all__ = ["describe_file", "describe_folder", "formats_help"]
 
 
 def _skeleton_lines(skeleton, skeleton_notes):
@@ -83,7 +83,9 @@ def _find_skeleton(amc, suffix):
     )
 
 
-def describe_file(path, *, asf=None, frame_rate=None, skeleton_notes=None):
+def describe_file(
+    path, *, asf=None, frame_rate=None, layout=None, skeleton_notes=None, position_notes=None
+):
     """The lines ``skmotion info`` prints for a motion file of any format in :data:`FORMATS`.
 
     Parameters
@@ -95,9 +97,14 @@ def describe_file(path, *, asf=None, frame_rate=None, skeleton_notes=None):
         ``.asf``) beside it.
     frame_rate : float, default=None
         Frames per second of a file that does not record it (keypoints).
+    layout : str or Layout, default=None
+        The joint order of a keypoint file (:func:`read_keypoints`).
     skeleton_notes : callable, default=None
         ``skeleton_notes(skeleton)`` gives further lines about a skeleton
         (the command adds its marker preset).
+    position_notes : callable, default=None
+        ``position_notes(motion)`` gives further lines about a position
+        motion (the command adds its check of ``layout``).
 
     Returns
     -------
@@ -136,11 +143,13 @@ def describe_file(path, *, asf=None, frame_rate=None, skeleton_notes=None):
         motion = row.reader(path, file_format(asf).reader(asf))
         head[1] += f", skeleton {asf}; frame rate not recorded in AMC files: CMU's 120 Hz"
     elif row.needs_frame_rate:
-        motion = row.reader(path, frame_rate=frame_rate or 1.0)
+        motion = row.reader(path, layout, frame_rate=frame_rate or 1.0)
     else:
         motion = row.reader(path)
     if motion.kind == "positions":
-        return head + _position_lines(motion, frame_rate is not None or not row.needs_frame_rate)
+        lines = _position_lines(motion, frame_rate is not None or not row.needs_frame_rate)
+        notes = list(position_notes(motion)) if position_notes is not None else []
+        return head + lines + notes
     return [
         *head,
         *_skeleton_lines(motion.skeleton, skeleton_notes),
@@ -149,21 +158,111 @@ def describe_file(path, *, asf=None, frame_rate=None, skeleton_notes=None):
     ]
 
 
-def formats_help():
-    """One line per format of :data:`FORMATS`, for help texts.
+def _summary(path, row, layout, frame_rate):
+    """(clips, frames, seconds or None, description of the channels) of one file."""
+    if row.kind == "series":
+        clips, _ = row.reader(path)
+        return len(clips), sum(len(c) for c in clips), None, f"{clips[0].shape[1]} dimensions"
+    if row.skeleton_suffix is not None:
+        asf = _find_skeleton(path, row.skeleton_suffix)
+        motion = row.reader(path, file_format(asf).reader(asf))
+    elif row.needs_frame_rate:
+        motion = row.reader(path, layout, frame_rate=frame_rate or 1.0)
+    else:
+        motion = row.reader(path)
+    seconds = motion.duration if frame_rate or not row.needs_frame_rate else None
+    what = f"{motion.n_channels} channels"
+    if motion.skeleton is not None:
+        what += f" ({motion.skeleton.n_joints}-joint skeleton)"
+    return 1, motion.n_frames, seconds, what
+
+
+def describe_folder(folder, *, layout=None, frame_rate=None):
+    """The lines ``skmotion info FOLDER`` prints: what the motion files under a folder hold.
+
+    Every file of a format in :data:`FORMATS` is read (keypoint files only
+    with ``layout``: a ``.csv`` may be an index or a labels file); files that
+    cannot be read are listed with the reason.
+
+    Parameters
+    ----------
+    folder : str or path-like
+    layout : str or Layout, default=None
+        The joint order of the keypoint files; None leaves them unread.
+    frame_rate : float, default=None
+        Frames per second of the keypoint files.
 
     Returns
     -------
-    text : str
+    lines : list of str
 
     Examples
     --------
-    >>> from skmotion.io._info import formats_help
-    >>> print(formats_help().splitlines()[0])
-    .bvh  BVH: skeleton and joint angles
+    >>> import os, tempfile
+    >>> from skmotion.datasets import make_motions
+    >>> from skmotion.io import Motion, write_bvh
+    >>> from skmotion.io._info import describe_folder
+    >>> data = make_motions(n_clips_per_class=2, classes=["wave"], random_state=0)
+    >>> with tempfile.TemporaryDirectory() as folder:
+    ...     for k, clip in enumerate(data.clips):
+    ...         os.makedirs(os.path.join(folder, f"S0{k}"))
+    ...         write_bvh(Motion(data.skeletons[k], clip, frame_rate=30),
+    ...                   os.path.join(folder, f"S0{k}", "wave.bvh"))
+    ...     lines = describe_folder(folder)
+    >>> print("\\n".join(lines[1:]))
+    files: 2 (2 BVH) in 2 subfolders (S00, S01)
+    clips: 2, 178 frames, 5.93 s (clip length 2.93-3.00 s)
+    channels: 66 channels (26-joint skeleton) x2
     """
-    return "\n".join(
-        f"{row.suffix:<5} {row.name}: {row.description}"
-        + (f" (extra '{row.extra}')" if row.extra else "")
-        for row in FORMATS
+    folder = Path(folder)
+    keypoints = {row.suffix for row in FORMATS if row.needs_frame_rate}
+    files, unread = [], Counter()
+    for path in sorted(p for p in folder.rglob("*") if p.is_file()):
+        suffix = path.suffix.lower()
+        known = any(row.suffix == suffix for row in FORMATS)
+        if known and suffix in keypoints and layout is None:
+            unread[suffix] += 1
+        elif known and file_format(path).kind != "skeleton":
+            files.append((file_format(path), path))
+    lines = [f"folder: {folder}"]
+    if not files:
+        return lines + ["files: no motion files" + _unread_text(unread)]
+    formats = Counter(row.name for row, _ in files)
+    subfolders = sorted({p.parent.relative_to(folder).as_posix() for _, p in files} - {"."})
+    where = f" in {len(subfolders)} subfolders ({_shown(subfolders, 4)})" if subfolders else ""
+    lines.append(
+        f"files: {len(files)} ("
+        + ", ".join(f"{n} {name}" for name, n in formats.items())
+        + f"){where}"
+        + _unread_text(unread)
     )
+    clips = frames = 0
+    seconds, kinds, errors = [], Counter(), []
+    for row, path in files:
+        try:
+            n, m, s, what = _summary(path, row, layout, frame_rate)
+        except (OSError, ValueError, ImportError) as exc:
+            reason = " ".join(str(exc).split()).removeprefix(f"{path}: ")
+            errors.append(f"  {path.relative_to(folder)}: {reason}")
+            continue
+        clips, frames = clips + n, frames + m
+        seconds += [s] if s is not None else []
+        kinds[what] += 1
+    timing = (
+        f", {sum(seconds):.2f} s (clip length {min(seconds):.2f}-{max(seconds):.2f} s)"
+        if seconds
+        else ""
+    )
+    lines.append(f"clips: {clips}, {frames:,} frames{timing}")
+    if kinds:
+        lines.append("channels: " + "; ".join(f"{what} x{n}" for what, n in kinds.most_common()))
+    if errors:
+        lines += [f"unreadable: {len(errors)} files"] + errors
+    return lines
+
+
+def _unread_text(unread):
+    if not unread:
+        return ""
+    shown = ", ".join(f"{n} {suffix}" for suffix, n in sorted(unread.items()))
+    return f"; not read: {shown} (keypoint files: give --layout and --frame-rate)"

@@ -1,17 +1,25 @@
 """Kinematics: the Skeleton, position layouts, rotation conventions, batched forward kinematics."""
 
-from skmotion.kinematics._body_size import body_size
-from skmotion.kinematics._forward import FKResult, forward_kinematics
-from skmotion.kinematics._layouts import Layout
-from skmotion.kinematics._marker_names import MARKER_NAMES
-from skmotion.kinematics._named_layouts import LAYOUTS, get_layout
-from skmotion.kinematics._rotations import (
-    check_rotation_order,
-    euler_to_matrix,
-    matrix_to_euler,
-    yaw_matrix,
+from skmotion._lazy import attach
+
+__getattr__, __dir__ = attach(
+    __name__,
+    {
+        "skmotion.kinematics._body_size": ["body_size"],
+        "skmotion.kinematics._forward": ["FKResult", "forward_kinematics"],
+        "skmotion.kinematics._layout_check": ["check_layout"],
+        "skmotion.kinematics._layouts": ["Layout"],
+        "skmotion.kinematics._marker_names": ["MARKER_NAMES"],
+        "skmotion.kinematics._named_layouts": ["LAYOUTS", "get_layout"],
+        "skmotion.kinematics._rotations": [
+            "check_rotation_order",
+            "euler_to_matrix",
+            "matrix_to_euler",
+            "yaw_matrix",
+        ],
+        "skmotion.kinematics._skeleton": ["CHANNEL_KINDS", "Skeleton"],
+    },
 )
-from skmotion.kinematics._skeleton import CHANNEL_KINDS, Skeleton
 
 __all__ = [
     "CHANNEL_KINDS",
@@ -21,6 +29,7 @@ __all__ = [
     "MARKER_NAMES",
     "Skeleton",
     "body_size",
+    "check_layout",
     "check_rotation_order",
     "euler_to_matrix",
     "forward_kinematics",

@@ -6,7 +6,6 @@ column vectors. This equals the extrinsic order read backwards (``"yxz"``).
 """
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 __all__ = ["check_rotation_order", "euler_to_matrix", "matrix_to_euler", "yaw_matrix"]
 
@@ -117,6 +116,8 @@ def matrix_to_euler(matrices, order):
     order = check_rotation_order(order)
     matrices = np.asarray(matrices, dtype=float)
     flat = matrices.reshape(-1, 3, 3)
+    from scipy.spatial.transform import Rotation  # on use: scipy.spatial takes ~0.5 s to import
+
     angles = Rotation.from_matrix(flat).as_euler(order)
     return angles.reshape(matrices.shape[:-2] + (3,))
 
@@ -147,4 +148,6 @@ def yaw_matrix(yaw, up_axis="y"):
     yaw = np.asarray(yaw, dtype=float)
     rotvec = np.zeros(yaw.shape + (3,))
     rotvec[..., axis] = yaw
+    from scipy.spatial.transform import Rotation
+
     return Rotation.from_rotvec(rotvec.reshape(-1, 3)).as_matrix().reshape(yaw.shape + (3, 3))

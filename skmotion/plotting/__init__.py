@@ -4,12 +4,23 @@ matplotlib is imported inside the functions, so ``import skmotion.plotting`` is
 cheap and works without it.
 """
 
-from ._bodies import animate_clip, plot_clip, plot_pose
-from ._body_data import BodyFrames, body_frames
-from ._neighbors import plot_pruning_recall
-from ._planning import plot_plan
-from ._primitives import plot_eigenmovements
-from ._tree import plot_motion_tree_layer, plot_motion_tree_layers, plot_motion_tree_profile
+from skmotion._lazy import attach
+
+__getattr__, __dir__ = attach(
+    __name__,
+    {
+        "skmotion.plotting._bodies": ["animate_clip", "plot_clip", "plot_pose"],
+        "skmotion.plotting._body_data": ["BodyFrames", "body_frames"],
+        "skmotion.plotting._neighbors": ["plot_pruning_recall"],
+        "skmotion.plotting._planning": ["plot_plan"],
+        "skmotion.plotting._primitives": ["plot_eigenmovements"],
+        "skmotion.plotting._tree": [
+            "plot_motion_tree_layer",
+            "plot_motion_tree_layers",
+            "plot_motion_tree_profile",
+        ],
+    },
+)
 
 __all__ = [
     "BodyFrames",

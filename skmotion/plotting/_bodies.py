@@ -145,18 +145,41 @@ def plot_pose(pose, body=None, *, bones=None, up_axis=None, ax=None, title=None)
     return figure
 
 
+def _travel_direction(root, body, size):
+    """Unit horizontal direction (drawn axes) from the first root to the last; the first
+    drawn axis for a motion that travels less than half the body's size (a squat's drift
+    says nothing)."""
+    axes = [0, 1] if body.up is None else list(_view_axes(body.up)[:2])
+    step = root[-1, axes] - root[0, axes]
+    length = float(np.hypot(*step))
+    return axes, (step / length if length > 0.5 * size else np.array([1.0, 0.0]))
+
+
 def _offsets(positions, body, spread):
-    """Sideways offsets that set poses apart when the body does not travel by itself."""
-    horizontal = 0 if body.up is None else _view_axes(body.up)[0]
-    extent = float(np.ptp(positions.reshape(-1, positions.shape[2]), axis=0).max())
+    """Per drawn pose, an offset along the travel direction so that no two poses overlap.
+
+    The root's own travel sets poses apart where it is long enough; where it is not (a
+    motion in place, or a slow step), each pose is pushed along the direction of travel
+    until it starts a small gap after the previous one ends. ``spread`` instead sets a
+    fixed distance between successive poses. Returns the offsets (n_poses, dims), the
+    extra distance added per pose (for the root path between poses), and the direction.
+    """
     root = positions[:, int(body.bones[0, 0]) if len(body.bones) else 0]
-    travel = float(np.ptp(root, axis=0).max())  # how far the root ranges, not end to end
-    if spread is None:
-        single = float(np.ptp(positions[0], axis=0).max())
-        spread = 0.0 if travel > 0.5 * single else 0.7 * single
+    axes, direction = _travel_direction(root, body, float(np.ptp(positions[0], axis=0).max()))
+    along = positions[:, :, axes] @ direction  # (n_poses, n_joints): position along travel
+    extra = np.zeros(len(positions))
+    if spread is not None:
+        extra = float(spread) * np.arange(len(positions))
+    else:
+        width = float(np.ptp(along, axis=1).max())
+        gap = 0.15 * max(width, float(np.ptp(positions[0], axis=0).max()))
+        for k in range(1, len(positions)):
+            start = along[k].min() + extra[k - 1]
+            end = along[k - 1].max() + extra[k - 1]
+            extra[k] = extra[k - 1] + max(0.0, end + gap - start)
     shift = np.zeros((len(positions), positions.shape[2]))
-    shift[:, horizontal] = spread * np.arange(len(positions))
-    return shift, spread, extent
+    shift[:, axes] = extra[:, None] * direction
+    return shift, extra, direction
 
 
 def plot_clip(
@@ -178,10 +201,11 @@ def plot_clip(
     n_poses : int, default=8
         How many poses, evenly spaced in time.
     spread : float, default=None
-        Distance between successive poses along the first horizontal axis (in the
-        positions' unit). By default poses are set apart only when the root travels less
-        than half the body's size (a motion in place would be drawn on top of itself);
-        the title says so.
+        Extra distance between successive poses along the direction of travel (in
+        the positions' unit). By default each pose is moved on just enough not to
+        overlap the previous one (a motion in place would be drawn on top of
+        itself); the root path follows the moved poses, and the title says how
+        far they were set apart. The view looks across the direction of travel.
     up_axis : {"x", "y", "z"}, default=None
         As in :func:`plot_pose`.
     ax : matplotlib Axes, default=None
@@ -212,30 +236,33 @@ def plot_clip(
     plt = _pyplot()
     dims = body.positions.shape[2]
     figure, ax = _new_axes(plt, dims, (6.5, 4.5)) if ax is None else (ax.figure, ax)
-    shift, spread, _ = _offsets(body.positions[frames], body, spread)
+    shift, extra, direction = _offsets(body.positions[frames], body, spread)
     times = frames / frame_rate if frame_rate else frames.astype(float)
     cmap = plt.get_cmap("viridis")
     norm = plt.Normalize(times.min(), max(times.max(), times.min() + 1e-9))
     for k, f in enumerate(frames):
         _draw(ax, body.positions[f] + shift[k], body, cmap(norm(times[k])), linewidth=1.5)
     root = int(body.bones[0, 0]) if len(body.bones) else 0
-    path = body.positions[:, root] + (shift[0] if spread == 0 else 0)
-    if spread == 0:
-        coords = path.T if body.up is None else [path[:, k] for k in _view_axes(body.up)]
-        ax.plot(*coords, "--", color="0.3", linewidth=1.5, label=f"root path ({body.names[root]})")
-        ax.legend(loc="upper left", fontsize="small")
+    # The root's path through the drawn poses: between two poses, the offset grows with time.
+    offset = np.interp(np.arange(n_frames), frames, extra)
+    axes = [0, 1] if body.up is None else list(_view_axes(body.up)[:2])
+    path = body.positions[:, root].copy()
+    path[:, axes] += offset[:, None] * direction
+    coords = path.T if body.up is None else [path[:, k] for k in _view_axes(body.up)]
+    ax.plot(*coords, "-", color="tab:red", linewidth=2.0, label=f"root path ({body.names[root]})")
+    ax.legend(loc="upper left", fontsize="small")
     mappable = plt.cm.ScalarMappable(norm=norm, cmap=cmap)
     label = "time (s)" if frame_rate else "frame"
-    figure.colorbar(mappable, ax=ax, shrink=0.7, pad=0.15, label=label)
-    if spread and body.up is not None:
-        ax.view_init(elev=12, azim=-75)  # look across the row of poses
+    figure.colorbar(mappable, ax=ax, shrink=0.7, pad=0.12, label=label)
+    if body.up is not None:
+        # Look across the row of poses: the direction of travel runs left to right on screen.
+        ax.view_init(elev=12, azim=float(np.degrees(np.arctan2(direction[1], direction[0]))) - 90)
     _label_axes(ax, body)
     drawn = (body.positions[frames] + shift[:, None, :]).reshape(-1, dims)
-    _set_limits(ax, np.vstack([drawn, path]) if spread == 0 else drawn, body.up)
-    apart = (
-        f", set {spread:.2g} apart along {_AXES[0 if body.up is None else _view_axes(body.up)[0]]}"
-    )
-    ax.set_title(f"{len(frames)} poses of {n_frames} frames" + (apart if spread else ""))
+    _set_limits(ax, np.vstack([drawn, path]), body.up)
+    added = extra[-1] if len(extra) > 1 else 0.0
+    apart = f", set apart by {added / max(len(frames) - 1, 1):.2g} more per pose" if added else ""
+    ax.set_title(f"{len(frames)} poses of {n_frames} frames{apart}")
     return figure
 
 

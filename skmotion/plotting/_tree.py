@@ -26,8 +26,48 @@ def _edges(graphs, layer, graph, min_probability):
     return counts.row[keep], counts.col[keep], prob[keep]
 
 
+def _robust_view(xy):
+    """Axis limits around the bulk of the nodes; an outlying node would squash the rest.
+
+    On an axis where the nodes' range is over three times the span of Tukey's
+    far-out fences (the quartiles widened by three interquartile ranges), the
+    view is the fences; nodes beyond are drawn on its edge (as triangles) and
+    counted. Elsewhere the view holds every node.
+    """
+    q1, q3 = np.percentile(xy, [25, 75], axis=0)
+    iqr = np.maximum(q3 - q1, 1e-12)
+    low, high = xy.min(axis=0), xy.max(axis=0)
+    fence_low = np.maximum(low, q1 - 3 * iqr)
+    fence_high = np.minimum(high, q3 + 3 * iqr)
+    squashed = (high - low) > 3 * (fence_high - fence_low)
+    low = np.where(squashed, fence_low, low)
+    high = np.where(squashed, fence_high, high)
+    outside = ((xy < low) | (xy > high)).any(axis=1)
+    return low, high, outside
+
+
+def _node_classes(tree, layer, frames, labels):
+    """Each node's most common label among the frames it holds, and that label's share."""
+    nodes = tree.apply(frames, layer)
+    labels = np.asarray(labels)
+    names, codes = np.unique(labels, return_inverse=True)
+    table = np.zeros((len(tree.counts(layer)), len(names)))
+    np.add.at(table, (nodes, codes), 1)
+    totals = np.maximum(table.sum(axis=1), 1)
+    return names, table.argmax(axis=1), table.max(axis=1) / totals, table.sum(axis=1) > 0
+
+
 def plot_motion_tree_layer(
-    tree, graphs=None, layer=-1, *, graph=0, axes=(0, 1), min_probability=0.05, ax=None
+    tree,
+    graphs=None,
+    layer=-1,
+    *,
+    graph=0,
+    axes=(0, 1),
+    min_probability=0.05,
+    frames=None,
+    labels=None,
+    ax=None,
 ):
     """The nodes of one layer on the first principal axes, with a transition graph.
 
@@ -35,9 +75,14 @@ def plot_motion_tree_layer(
 
     Each node is drawn at its mean frame projected on principal axes of all
     frames (``tree.principal_axes``), with an area that grows with its frame
-    count and a colour for its spread (largest standard deviation); each seen
-    transition between two different nodes whose probability reaches
-    ``min_probability`` is a line, darker for likelier transitions.
+    count; each seen transition between two different nodes whose probability
+    reaches ``min_probability`` is a line, darker for likelier transitions.
+    Given the training ``frames`` and their ``labels`` (the class, or the
+    clip, of each frame), a node takes the colour of the label most of its
+    frames carry, paler when fewer of them do; without them, the colour is
+    the node's spread (largest standard deviation). The view holds the bulk
+    of the nodes: a far outlying node is drawn on the edge as a triangle and
+    counted in the title, instead of squashing the others onto a line.
 
     Parameters
     ----------
@@ -52,6 +97,11 @@ def plot_motion_tree_layer(
         Which principal axes to plot.
     min_probability : float, default=0.05
         Transitions below it are not drawn.
+    frames : ndarray of shape (n_frames, n_channels), default=None
+        Frames in the tree's units (for a MotionTreeHMM, standardised:
+        ``(x - model.center_) / model.scale_``), to colour nodes by label.
+    labels : array-like of shape (n_frames,), default=None
+        The label of each of ``frames``.
     ax : matplotlib Axes, default=None
         Where to draw; a new figure by default.
 
@@ -64,14 +114,21 @@ def plot_motion_tree_layer(
     >>> import pytest
     >>> matplotlib = pytest.importorskip("matplotlib")
     >>> matplotlib.use("Agg")
+    >>> import numpy as np
     >>> from skmotion.datasets import make_motions
     >>> from skmotion.plotting import plot_motion_tree_layer
     >>> from skmotion.tree import MotionTreeHMM
     >>> data = make_motions(n_clips_per_class=2, classes=["walk", "jump"], random_state=0)
-    >>> model = MotionTreeHMM(max_depth=4).fit([c[:, 6:] for c in data.clips], data.target)
-    >>> ax = plot_motion_tree_layer(model.tree_, model.global_graph_, layer=3)
+    >>> clips = [c[:, 6:] for c in data.clips]
+    >>> model = MotionTreeHMM(max_depth=4).fit(clips, data.target)
+    >>> frames = (np.vstack(clips) - model.center_) / model.scale_
+    >>> labels = np.repeat(data.target_names[data.target], [len(c) for c in clips])
+    >>> ax = plot_motion_tree_layer(model.tree_, model.global_graph_, layer=3,
+    ...                             frames=frames, labels=labels)
     >>> len(ax.collections[0].get_offsets()) == int(model.n_nodes_[3])
     True
+    >>> [t.get_text() for t in ax.get_legend().get_texts()][2:4]
+    ['jump', 'walk']
     """
     plt = _pyplot()
     layer = tree.check_layer(layer)
@@ -79,52 +136,90 @@ def plot_motion_tree_layer(
         _, ax = plt.subplots(figsize=(5, 4))
     basis = tree.principal_axes[list(axes)]
     xy = (tree.means(layer) - tree.mean[0]) @ basis.T
+    low, high, outside = _robust_view(xy)
+    shown = np.clip(xy, low, high)
     if graphs is not None:
         src, dst, prob = _edges(graphs, layer, graph, min_probability)
         for a, b, p in zip(src, dst, prob):
             ax.plot(
-                xy[[a, b], 0],
-                xy[[a, b], 1],
-                color="tab:red",
-                alpha=float(min(1.0, 0.15 + p)),
-                lw=0.8,
+                shown[[a, b], 0],
+                shown[[a, b], 1],
+                color="0.45",
+                alpha=float(min(1.0, 0.1 + p)),
+                lw=0.7,
                 zorder=1,
             )
     counts = tree.counts(layer)
-    spread = np.maximum(_node_spread(tree, layer), 1e-12)
-    wide = spread.max() > 10 * spread.min()
-    nodes = ax.scatter(
-        xy[:, 0],
-        xy[:, 1],
-        s=20 + 200 * counts / counts.max(),
-        c=spread,
-        cmap="viridis",
-        # Spreads span orders of magnitude (a few wide nodes); a log scale keeps the rest apart.
-        norm=plt.matplotlib.colors.LogNorm(spread.min(), spread.max()) if wide else None,
-        edgecolors="k",
-        linewidths=0.4,
-        zorder=2,
-    )
-    ax.figure.colorbar(nodes, ax=ax, label="node spread (largest std)" + (", log" if wide else ""))
+    sizes = 20 + 200 * counts / counts.max()
     from matplotlib.lines import Line2D
 
     handles = [
         Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=4, label="node, small: few frames"),
         Line2D([], [], marker="o", ls="", mfc="w", mec="k", ms=11, label="node, large: many"),
     ]
+    if frames is not None and labels is not None:
+        names, majority, share, seen = _node_classes(tree, layer, frames, labels)
+        palette = plt.get_cmap("tab10" if len(names) <= 10 else "tab20")
+        colours = np.array([palette(k % palette.N) for k in majority])
+        colours[:, 3] = np.where(seen, 0.35 + 0.65 * share, 0.15)  # paler: mixed nodes
+        style = {"c": colours}
+        handles += [
+            Line2D([], [], marker="o", ls="", mfc=palette(k % palette.N), mec="k", ms=6,
+                   label=str(name))
+            for k, name in enumerate(names)
+        ]  # fmt: skip
+        colour_text = "colour: most frames' label"
+    else:
+        spread = np.maximum(_node_spread(tree, layer), 1e-12)
+        wide = spread.max() > 10 * spread.min()
+        style = {
+            "c": spread,
+            "cmap": "viridis",
+            # Spreads span orders of magnitude (a few wide nodes); a log scale keeps the rest apart.
+            "norm": plt.matplotlib.colors.LogNorm(spread.min(), spread.max()) if wide else None,
+        }
+        colour_text = None
+    inside = ~outside
+    nodes = ax.scatter(
+        shown[:, 0], shown[:, 1], s=np.where(inside, sizes, 0), edgecolors="k", linewidths=0.4,
+        zorder=2, **style,
+    )  # fmt: skip
+    if outside.any():
+        ax.scatter(
+            shown[outside, 0], shown[outside, 1], s=40, marker="^", c="none", edgecolors="k",
+            linewidths=0.8, zorder=3,
+        )  # fmt: skip
+        handles.append(
+            Line2D([], [], marker="^", ls="", mfc="none", mec="k", ms=6, label="node off the view")
+        )
+    if colour_text is None:
+        ax.figure.colorbar(
+            nodes, ax=ax, label="node spread (largest std)" + (", log" if style["norm"] else "")
+        )
     if graphs is not None:
         handles.append(
-            Line2D([], [], color="tab:red", lw=0.8, label=f"transition, p >= {min_probability:g}")
+            Line2D([], [], color="0.45", lw=0.8, label=f"transition, p >= {min_probability:g}")
         )
-    ax.legend(handles=handles, loc="best", fontsize="x-small")
+    ax.legend(handles=handles, loc="center left", bbox_to_anchor=(1.01, 0.5), fontsize="x-small")
+    ax.set_xlim(low[0] - 0.02 * (high[0] - low[0]), high[0] + 0.02 * (high[0] - low[0]))
+    ax.set_ylim(low[1] - 0.02 * (high[1] - low[1]), high[1] + 0.02 * (high[1] - low[1]))
     ax.set_xlabel(f"principal axis {axes[0] + 1}")
     ax.set_ylabel(f"principal axis {axes[1] + 1}")
-    ax.set_title(f"layer {layer}: {len(counts)} nodes")
+    off = f", {int(outside.sum())} off the view (triangles at the edge)" if outside.any() else ""
+    ax.set_title(f"layer {layer}: {len(counts)} nodes{off}", fontsize="medium")
     return ax
 
 
 def plot_motion_tree_layers(
-    tree, graphs=None, layers=None, *, graph=0, axes=(0, 1), min_probability=0.05
+    tree,
+    graphs=None,
+    layers=None,
+    *,
+    graph=0,
+    axes=(0, 1),
+    min_probability=0.05,
+    frames=None,
+    labels=None,
 ):
     """Several layers side by side (Yamane et al. 2011, Figure 5, show layers 4 and 7).
 
@@ -137,6 +232,8 @@ def plot_motion_tree_layers(
     graph : int, default=0
     axes : tuple of two int, default=(0, 1)
     min_probability : float, default=0.05
+    frames, labels : default=None
+        As in :func:`plot_motion_tree_layer`: colour the nodes by label.
 
     Returns
     -------
@@ -159,11 +256,14 @@ def plot_motion_tree_layers(
     if layers is None:
         bottom = tree.n_layers - 1
         layers = sorted({max(1, bottom // 3), max(1, 2 * bottom // 3), bottom})
-    fig, panels = plt.subplots(1, len(layers), figsize=(5.5 * len(layers), 4.2), squeeze=False)
+    fig, panels = plt.subplots(1, len(layers), figsize=(6.5 * len(layers), 4.6), squeeze=False)
     for ax, layer in zip(panels[0], layers):
         plot_motion_tree_layer(
-            tree, graphs, layer, graph=graph, axes=axes, min_probability=min_probability, ax=ax
-        )
+            tree, graphs, layer, graph=graph, axes=axes, min_probability=min_probability,
+            frames=frames, labels=labels, ax=ax,
+        )  # fmt: skip
+    for ax in panels[0][:-1]:
+        ax.get_legend().remove()  # one legend, beside the last panel, serves them all
     fig.tight_layout()
     return fig
 

@@ -1,29 +1,37 @@
 """Preprocessing: clip-to-clip transformers and the steps that bridge to sklearn."""
 
-from skmotion.kinematics._layouts import Layout
-from skmotion.kinematics._named_layouts import LAYOUTS, get_layout
-from skmotion.preprocessing._body_frame import body_frame_features, body_size
-from skmotion.preprocessing._fill_gaps import FillGaps
-from skmotion.preprocessing._filter import LowPassFilter, filter_min_frames, lowpass_filter
-from skmotion.preprocessing._flatten import FlattenClips
-from skmotion.preprocessing._marker_presets import (
-    MARKER_NAMES,
-    MARKER_PRESETS,
-    detect_marker_preset,
-    marker_preset,
+from skmotion._lazy import attach
+
+__getattr__, __dir__ = attach(
+    __name__,
+    {
+        "skmotion.kinematics._layouts": ["Layout"],
+        "skmotion.kinematics._named_layouts": ["LAYOUTS", "get_layout"],
+        "skmotion.preprocessing._body_frame": ["body_frame_features", "body_size"],
+        "skmotion.preprocessing._fill_gaps": ["FillGaps"],
+        "skmotion.preprocessing._filter": ["LowPassFilter", "filter_min_frames", "lowpass_filter"],
+        "skmotion.preprocessing._flatten": ["FlattenClips"],
+        "skmotion.preprocessing._marker_presets": [
+            "MARKER_NAMES",
+            "MARKER_PRESETS",
+            "detect_marker_preset",
+            "marker_preset",
+        ],
+        "skmotion.preprocessing._marker_set": ["Marker", "MarkerSet"],
+        "skmotion.preprocessing._resample": ["ResampleClips", "resample_clip"],
+        "skmotion.preprocessing._segment": [
+            "SEGMENTATION_RULES",
+            "energy_segments",
+            "movement_energy",
+            "segment_clip",
+            "zero_velocity_crossings",
+            "zvc_segments",
+        ],
+        "skmotion.preprocessing._to_markers": ["to_markers"],
+        "skmotion.preprocessing._virtual_markers": ["SIZE_CHAIN", "VirtualMarkerTransform"],
+        "skmotion.preprocessing._to_aeon": ["ToAeon"],
+    },
 )
-from skmotion.preprocessing._marker_set import Marker, MarkerSet
-from skmotion.preprocessing._resample import ResampleClips, resample_clip
-from skmotion.preprocessing._segment import (
-    SEGMENTATION_RULES,
-    energy_segments,
-    movement_energy,
-    segment_clip,
-    zero_velocity_crossings,
-    zvc_segments,
-)
-from skmotion.preprocessing._to_markers import to_markers
-from skmotion.preprocessing._virtual_markers import SIZE_CHAIN, VirtualMarkerTransform
 
 __all__ = [
     "FillGaps",
@@ -38,6 +46,7 @@ __all__ = [
     "ResampleClips",
     "SEGMENTATION_RULES",
     "SIZE_CHAIN",
+    "ToAeon",
     "VirtualMarkerTransform",
     "body_frame_features",
     "body_size",
