@@ -400,7 +400,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     def __setstate__(self, state):
         super().__setstate__(state)
-        if type(self._stored) is GrowableStore:  # pickled before StoredClips
+        # an unfitted index has no store; one pickled before StoredClips holds a GrowableStore
+        if type(getattr(self, "_stored", None)) is GrowableStore:
             self._stored = StoredClips.adopt(self._stored)
 
     # -- input -------------------------------------------------------------------

@@ -338,3 +338,12 @@ def test_verbose_reports_the_stages_of_fit_and_is_silent_by_default(repeated, ca
     err = capsys.readouterr().err
     for stage in ("decomposing the clips", "learning the entry widths", "building the tree"):
         assert stage in err
+
+
+def test_an_unfitted_index_pickles():
+    """joblib and Dask send unfitted clones to their workers: they must load there."""
+    import pickle
+
+    index = pickle.loads(pickle.dumps(IntervalIndexNeighbors(epsilon=0.5)))
+    assert index.get_params()["epsilon"] == 0.5
+    assert not hasattr(index, "_stored")
