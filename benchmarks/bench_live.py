@@ -67,6 +67,8 @@ if os.environ.get("SKMOTION_BENCH_BASELINE"):  # a --baseline worker: that folde
 # A worktree outside the project folder finds the data through the tests' variable.
 SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
 
+from _live_detection import detection, labelling  # noqa: E402
+
 from skmotion.datasets import load_uea, make_motions  # noqa: E402
 from skmotion.tree import MotionTreeHMM  # noqa: E402
 from skmotion.tree._incremental import clip_counts, node_moments  # noqa: E402
@@ -536,7 +538,8 @@ def main():
     parser.add_argument(
         "--only",
         nargs="*",
-        help="update, growth, stream, latency, agreement, synthesis (default: all)",
+        help="update, growth, stream, latency, agreement, synthesis, detection, labelling "
+        "(default: all; the last two need MSRC-12 in ../shared/data)",
     )
     parser.add_argument(
         "--baseline",
@@ -550,7 +553,14 @@ def main():
 
         print(json.dumps(_single_frame_cost(args.quick)))
         return
-    only = set(args.only or ["update", "growth", "stream", "latency", "agreement", "synthesis"])
+    only = set(
+        args.only
+        or ["update", "growth", "stream", "latency", "agreement", "synthesis", "detection"]
+        + ["labelling"]
+    )
+    if {"detection", "labelling"} & only and not (SHARED_DATA / "msrc12").is_dir():
+        print(f"MSRC-12: not found in {SHARED_DATA}, detection and labelling left out")
+        only -= {"detection", "labelling"}
     sets = datasets(args.quick)
     note = "Shared machine: compare ratios within one run. Default MotionTreeHMM parameters."
     if "update" in only:
@@ -568,6 +578,16 @@ def main():
         write_results("live_online_agreement", agreement(sets), notes=note)
     if "synthesis" in only:
         write_results("live_synthesis", synthesis(sets), notes=note)
+    msrc_note = (
+        "MSRC-12, odd people train, even people test; threshold and refractory period by "
+        "GroupKFold(3) over the training people (out-of-fold F1 at 0.5 s). Window 30 frames "
+        "(2 s), step 2. F1: one event per repetition, extra events false; '+-': an event "
+        "within the latency before or after the action point, 'after only': at or after it."
+    )
+    if "detection" in only:
+        write_results("live_detection", detection(args.quick), notes=msrc_note)
+    if "labelling" in only:
+        write_results("live_labelling", labelling(args.quick), notes=msrc_note)
 
 
 if __name__ == "__main__":

@@ -8,12 +8,12 @@ from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
-from skmotion.live._events import next_events
+from skmotion.live._events import TRIGGERS, TriggerState, next_events
 from skmotion.live._recognizers import class_proba, default_recognizer, recognizer_classes
 from skmotion.live._stream import DetectorStream
 from skmotion.live._windows import evaluation_ends, take_windows, training_windows
 from skmotion.utils._clips import check_clips
-from skmotion.utils._sklearn_compat import HasMethods, Interval, _fit_context
+from skmotion.utils._sklearn_compat import HasMethods, Interval, StrOptions, _fit_context
 
 __all__ = ["GestureDetector"]
 
@@ -35,9 +35,12 @@ def _labels_per_point(y, action_points):
 
 
 def _check_points(action_points, clips):
-    if action_points is None or len(action_points) != len(clips):
-        got = "none" if action_points is None else len(action_points)
-        raise ValueError(f"action_points: one array per take is needed ({len(clips)}), got {got}.")
+    if action_points is None:  # clips that each end as their motion completes
+        return [np.array([len(take) - 1], dtype=np.intp) for take in clips]
+    if len(action_points) != len(clips):
+        raise ValueError(
+            f"action_points: one array per take is needed ({len(clips)}), got {len(action_points)}."
+        )
     checked = []
     for i, (points, take) in enumerate(zip(action_points, clips)):
         points = np.asarray(points)
@@ -63,9 +66,11 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
     that end elsewhere (labelled ``none_label``, the rejection class: "nothing
     known is completing now"), the setting of Fothergill et al. (2012) for
     MSRC-12. An event is emitted at an evaluated frame when the best motion's
-    probability reaches ``threshold`` and ``refractory`` frames have passed
-    since the last event: the threshold trades misses for false alarms, and
-    ``step`` and ``refractory`` trade latency for cost and for repeated events.
+    probability falls back below ``threshold`` after a run above it (or, with
+    ``trigger="rise"``, when it first reaches it) and ``refractory`` frames
+    have passed since the last event: the threshold trades misses for false
+    alarms, and ``step`` and ``refractory`` trade latency for cost and for
+    repeated events.
 
     :meth:`detect` scores all windows of whole takes at once;
     :meth:`stream` returns a :class:`DetectorStream` fed one frame (or a
@@ -88,9 +93,17 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
     step : int, default=2
         Frames between two scored windows (the first ends at frame ``window - 1``).
     threshold : float, default=0.5
-        The least probability of the best motion for an event.
+        The probability of the best motion that starts (``"rise"``) or whose
+        loss ends (``"fall"``) an event.
     refractory : int, default=15
         The fewest frames between two events.
+    trigger : {"fall", "rise"}, default="fall"
+        ``"rise"``: an event at the first window whose score reaches
+        ``threshold``; ``"fall"``: when the score falls back below it after
+        a run at or above it, with the run's best motion and score (a window
+        stops matching once its motion is over: the fall marks the
+        completion, where a recogniser that knows a motion early rises long
+        before it).
     n_negatives : int, default=20
         Windows ending away from action points drawn per training take.
     negative_gap : int, default=3
@@ -144,6 +157,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         "step": [Interval(Integral, 1, None, closed="left")],
         "threshold": [Interval(Real, 0, 1, closed="both")],
         "refractory": [Interval(Integral, 0, None, closed="left")],
+        "trigger": [StrOptions(set(TRIGGERS))],
         "n_negatives": [Interval(Integral, 0, None, closed="left")],
         "negative_gap": [Interval(Integral, 0, None, closed="left")],
         "none_label": [str],
@@ -159,6 +173,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         step=2,
         threshold=0.5,
         refractory=15,
+        trigger="fall",
         n_negatives=20,
         negative_gap=3,
         none_label="none",
@@ -169,13 +184,14 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.step = step
         self.threshold = threshold
         self.refractory = refractory
+        self.trigger = trigger
         self.n_negatives = n_negatives
         self.negative_gap = negative_gap
         self.none_label = none_label
         self.random_state = random_state
 
     @_fit_context(prefer_skip_nested_validation=False)
-    def fit(self, X, y, *, action_points):
+    def fit(self, X, y, *, action_points=None):
         """Train the recogniser on windows ending at action points and elsewhere.
 
         Parameters
@@ -185,8 +201,10 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         y : array-like of shape (n_takes,)
             The motion of each take, or per take an array with the motion of
             each of its action points.
-        action_points : list of array-like of int
-            Per take, the frames at which a repetition is complete.
+        action_points : list of array-like of int, default=None
+            Per take, the frames at which a repetition is complete. None: each
+            take is one repetition, complete at its last frame (a collection
+            of clips).
 
         Returns
         -------
@@ -220,7 +238,9 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.classes_ = recognizer_classes(self.recognizer_)
         found = np.flatnonzero(self.classes_ == self.none_label)
         if not len(found):
-            raise ValueError(f"the recogniser's classes lack the rejection class {self.none_label!r}.")
+            raise ValueError(
+                f"the recogniser's classes lack the rejection class {self.none_label!r}."
+            )
         self.none_index_ = int(found[0])
         return self
 
@@ -244,9 +264,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         ends = [evaluation_ends(len(take), self.window, self.step) for take in clips]
         windows = [w for take, e in zip(clips, ends) for w in take_windows(take, e, self.window)]
         proba = (
-            class_proba(self.recognizer_, windows)
-            if windows
-            else np.zeros((0, len(self.classes_)))
+            class_proba(self.recognizer_, windows) if windows else np.zeros((0, len(self.classes_)))
         )
         splits = np.cumsum([len(e) for e in ends])[:-1]
         return list(zip(ends, np.split(proba, splits)))
@@ -273,7 +291,8 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
                 self.none_index_,
                 threshold=self.threshold,
                 refractory=self.refractory,
-                last=None,
+                trigger=self.trigger,
+                state=TriggerState(),
             )
             out.append(events)
         return out
@@ -297,4 +316,5 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
             none_index=self.none_index_,
             threshold=self.threshold,
             refractory=self.refractory,
+            trigger=self.trigger,
         )

@@ -33,7 +33,7 @@ def recognizer_classes(recognizer):
 
 
 def class_proba(recognizer, windows):
-    """Class probabilities of each window: ``predict_proba``, else a softmax of ``decision_function``.
+    """Class probabilities of windows: ``predict_proba``, else a softmax of ``decision_function``.
 
     A binary ``decision_function`` (one column, the second class's margin) becomes
     ``[-d, d] / 2`` before the softmax, i.e. the logistic of ``d``.

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from skmotion.live._events import next_events
+from skmotion.live._events import TriggerState, next_events
 
 __all__ = ["DetectorStream"]
 
@@ -15,7 +15,7 @@ class DetectorStream:
     ``window`` frames are always one contiguous slice, in order, without a
     copy; every ``step`` frames (the first at frame ``window - 1``) that slice
     is scored and the decision rule of :func:`next_events` runs on it. Memory
-    is the buffer and the last event's frame, whatever the stream's length;
+    is the buffer and the decision rule's state (a few numbers), whatever the stream's length;
     a frame costs a row copy, and every ``step``-th one a window's scoring.
 
     Parameters
@@ -28,6 +28,7 @@ class DetectorStream:
     none_index : int
     threshold : float
     refractory : int
+    trigger : {"fall", "rise"}, default="fall"
 
     Attributes
     ----------
@@ -38,12 +39,22 @@ class DetectorStream:
     """
 
     def __init__(
-        self, score, *, n_channels, window, step, classes, none_index, threshold, refractory
+        self,
+        score,
+        *,
+        n_channels,
+        window,
+        step,
+        classes,
+        none_index,
+        threshold,
+        refractory,
+        trigger="fall",
     ):
         self._score = score
         self._window, self._step = int(window), int(step)
         self._classes, self._none = classes, none_index
-        self._threshold, self._refractory = threshold, refractory
+        self._threshold, self._refractory, self._trigger = threshold, refractory, trigger
         self._buffer = np.zeros((2 * self._window, int(n_channels)))
         self.reset()
 
@@ -51,7 +62,7 @@ class DetectorStream:
         """Forget every frame: the stream starts again."""
         self.n_frames = 0
         self.last_proba = None
-        self._last_event = None
+        self._state = TriggerState()
         self._buffer[:] = 0.0
 
     def update(self, frames):
@@ -72,8 +83,7 @@ class DetectorStream:
         width = self._buffer.shape[1]
         if frames.ndim != 2 or frames.shape[1] != width:
             raise ValueError(
-                f"update: frames must have {width} channels, got an array of shape "
-                f"{frames.shape}."
+                f"update: frames must have {width} channels, got an array of shape {frames.shape}."
             )
         if not np.isfinite(frames).all():
             row = int(np.flatnonzero(~np.isfinite(frames).all(axis=1))[0])
@@ -89,14 +99,15 @@ class DetectorStream:
             if t >= w - 1 and (t - w + 1) % self._step == 0:
                 proba = self._score(self._buffer[i + 1 : i + 1 + w])
                 self.last_proba = proba[0]
-                new, self._last_event = next_events(
+                new, self._state = next_events(
                     np.array([t]),
                     proba,
                     self._classes,
                     self._none,
                     threshold=self._threshold,
                     refractory=self._refractory,
-                    last=self._last_event,
+                    trigger=self._trigger,
+                    state=self._state,
                 )
                 events += new
         return events

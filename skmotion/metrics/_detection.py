@@ -83,7 +83,7 @@ def detection_f1(action_points, point_labels, events, *, latency, early=None):
     --------
     >>> from skmotion.metrics import detection_f1
     >>> events = [[(12, "kick", 0.9), (30, "kick", 0.8), (52, "duck", 0.7)]]
-    >>> detection_f1([[10, 50]], [["kick", "kick"]], events, latency=5)  # 1 found, 2 false, 1 missed
+    >>> detection_f1([[10, 50]], [["kick", "kick"]], events, latency=5)  # 1 found, 2 false, 1 miss
     0.4
     """
     counts = detection_counts(action_points, point_labels, events, latency=latency, early=early)
