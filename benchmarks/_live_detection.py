@@ -6,6 +6,7 @@ period) by GroupKFold over the training people only, on out-of-fold scores.
 """
 
 import time
+from pathlib import Path
 
 import numpy as np
 from _common import SHARED_DATA
@@ -23,6 +24,7 @@ from skmotion.preprocessing import FlattenClips, ResampleClips, VirtualMarkerTra
 from skmotion.tree import MotionTreeEncoder
 
 RATE = 15  # frames per second of the stored MSRC-12
+FIGURE = Path(__file__).resolve().parents[1] / "docs" / "images" / "live_detection.png"
 LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
 THRESHOLDS = np.round(np.linspace(0.05, 0.95, 19), 2)
 REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
@@ -163,7 +165,7 @@ def detection(quick, step=2, window=30):
         train, test = train[::6], test[::6]
     Xtr, Xte = [takes[i] for i in train], [takes[i] for i in test]
     names = [np.full(len(aps[i]), gestures[i], dtype=object) for i in test]
-    rows, costs = [], []
+    rows, costs, fitted = [], [], {}
     for name, recogniser in recognisers().items():
         params = dict(
             recognizer=recogniser, window=window, step=step, n_negatives=10, random_state=0
@@ -177,6 +179,7 @@ def detection(quick, step=2, window=30):
         detector.fit(Xtr, gestures[train], action_points=[aps[i] for i in train])
         fit_s = time.perf_counter() - start
         events = detector.detect(Xte)
+        fitted[name] = detector
         stream = detector.stream()  # the stream gives the batch's events (one take checked)
         streamed = [e for frame in Xte[0] for e in stream.update(frame)]
         same = [(e.frame, e.label) for e in streamed] == [(e.frame, e.label) for e in events[0]]
@@ -209,7 +212,51 @@ def detection(quick, step=2, window=30):
                 )
                 rows.append(row)
                 print({k: row[k] for k in ("recogniser", "latency s", "window", "F1")}, flush=True)
+    figure(fitted, Xte[0], aps[test[0]], gestures[test[0]], FIGURE)
     return rows
+
+
+def figure(detectors, take, points, gesture, path):
+    """Each recogniser's score over one held-out take, its events and the action points."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(detectors), 1, figsize=(9, 2.1 * len(detectors)), sharex=True)
+    for ax, (name, detector) in zip(np.atleast_1d(axes), detectors.items()):
+        ((ends, proba),) = detector.scores([take])
+        score = np.delete(proba, detector.none_index_, axis=1).max(axis=1)
+        ax.plot(ends / RATE, score, color="tab:blue", lw=1, label="best gesture's probability")
+        ax.axhline(detector.threshold, color="grey", ls=":", lw=1, label="threshold")
+        for k, a in enumerate(points):
+            ax.axvline(a / RATE, color="tab:green", lw=1, label="action point" if k == 0 else None)
+        events = detector.detect([take])[0]
+        right = [e for e in events if e.label == gesture]
+        wrong = [e for e in events if e.label != gesture]
+        ax.plot(
+            [e.frame / RATE for e in right],
+            [e.score for e in right],
+            "v",
+            color="tab:orange",
+            label=f"event: {gesture}",
+        )
+        ax.plot(
+            [e.frame / RATE for e in wrong],
+            [e.score for e in wrong],
+            "x",
+            color="tab:red",
+            label="event: another gesture",
+        )
+        ax.set_ylim(0, 1.05)
+        ax.set_ylabel("probability")
+        ax.set_title(f"{name} (trigger {detector.trigger!r})", fontsize=9)
+    ax.set_xlabel("time (s)")
+    np.atleast_1d(axes)[0].legend(loc="lower left", fontsize=7, ncol=5)
+    fig.tight_layout()
+    path.parent.mkdir(exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
 
 
 def labelling(quick, window=30, seed=0):
