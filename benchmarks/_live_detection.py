@@ -35,7 +35,10 @@ GESTURES = (
 
 
 def msrc12():
-    """Takes (float positions), action points, gestures, person ids; empty takes left out."""
+    """Takes (float positions), action points, gestures, person ids; empty takes left out.
+
+    The stored takes lost their untracked (all-zero) frames: the few action points
+    before a take's first frame or past its last are left out."""
     data = np.load(SHARED_DATA / "msrc12" / "msrc12_sequences.npz")
     positions, offsets = data["positions"], data["offsets"]
     points, point_offsets = data["action_points"], data["action_point_offsets"]
@@ -45,7 +48,8 @@ def msrc12():
         if len(take) < 2:
             continue
         takes.append(take)
-        aps.append(points[point_offsets[i] : point_offsets[i + 1]].astype(np.intp))
+        found = points[point_offsets[i] : point_offsets[i + 1]].astype(np.intp)
+        aps.append(found[(found >= 0) & (found < len(take))])  # a few fall in removed frames
         gestures.append(GESTURES[int(data["gesture"][i]) - 1])
         people.append(int(data["person"][i]))
     return takes, aps, np.array(gestures, dtype=object), np.array(people)
