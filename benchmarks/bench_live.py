@@ -76,7 +76,7 @@ if os.environ.get("SKMOTION_BENCH_BASELINE"):  # a --baseline worker: that folde
 # A worktree outside the project folder finds the data through the tests' variable.
 SHARED_DATA = Path(os.environ.get("SKMOTION_SHARED_DATA", SHARED_DATA))
 
-from _live_detection import detection, labelling  # noqa: E402
+from _live_detection import decoder_stream, detection, labelling  # noqa: E402
 
 from skmotion.datasets import load_uea, make_motions  # noqa: E402
 from skmotion.tree import MotionTreeHMM  # noqa: E402
@@ -586,7 +586,7 @@ def main():
     parser.add_argument(
         "--only",
         nargs="*",
-        help="update, growth, stream, latency, agreement, synthesis, detection, labelling "
+        help="update, growth, stream, latency, agreement, synthesis, detection, labelling, decoder "
         "(default: all; the last two need MSRC-12 in ../shared/data)",
     )
     parser.add_argument(
@@ -604,11 +604,11 @@ def main():
     only = set(
         args.only
         or ["update", "growth", "stream", "latency", "agreement", "synthesis", "detection"]
-        + ["labelling"]
+        + ["labelling", "decoder"]
     )
-    if {"detection", "labelling"} & only and not (SHARED_DATA / "msrc12").is_dir():
-        print(f"MSRC-12: not found in {SHARED_DATA}, detection and labelling left out")
-        only -= {"detection", "labelling"}
+    if {"detection", "labelling", "decoder"} & only and not (SHARED_DATA / "msrc12").is_dir():
+        print(f"MSRC-12: not found in {SHARED_DATA}, its studies left out")
+        only -= {"detection", "labelling", "decoder"}
     sets = datasets(args.quick)
     note = "Shared machine: compare ratios within one run. Default MotionTreeHMM parameters."
     if "update" in only:
@@ -636,6 +636,8 @@ def main():
         write_results("live_detection", detection(args.quick), notes=msrc_note)
     if "labelling" in only:
         write_results("live_labelling", labelling(args.quick), notes=msrc_note)
+    if "decoder" in only:
+        write_results("live_decoder_stream", decoder_stream(args.quick), notes=msrc_note)
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ _SUBPACKAGES = (
     "decomposition",
     "io",
     "kinematics",
+    "live",
     "metrics",
     "neighbors",
     "plotting",
