@@ -265,7 +265,7 @@ def figure(detectors, take, points, gesture, path):
     plt.close(fig)
 
 
-def labelling(quick, window=30, seed=0):
+def labelling(quick, window=60, seed=0):
     """Frame accuracy of ActivitySegmenter on held-out takes of different gestures, concatenated."""
     takes, _, gestures, people = msrc12()
     train = np.flatnonzero(people % 2 == 1)

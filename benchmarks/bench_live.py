@@ -628,8 +628,9 @@ def main():
         write_results("live_synthesis", synthesis(sets), notes=note)
     msrc_note = (
         "MSRC-12, odd people train, even people test; threshold and refractory period by "
-        "GroupKFold(3) over the training people (out-of-fold F1 at 0.5 s). Window 30 frames "
-        "(2 s), step 2. F1: one event per repetition, extra events false; '+-': an event "
+        "GroupKFold(3) over the training people (out-of-fold F1 at 0.5 s). Detection: window "
+        "30 frames (2 s), step 2; labelling: window 60 frames (4 s), step 5. F1: one event "
+        "per repetition, extra events false; '+-': an event "
         "within the latency before or after the action point, 'after only': at or after it."
     )
     if "detection" in only:
