@@ -15,6 +15,7 @@ from skmotion.base import IncompatibleVersionError, VersionedStateMixin, compati
 from skmotion.control import KMeansPrimitiveController
 from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
+from skmotion.live import ActivitySegmenter, GestureDetector
 from skmotion.neighbors import IntervalIndexNeighbors
 from skmotion.preprocessing import (
     FillGaps,
@@ -105,6 +106,16 @@ CASES = {
     "FlattenClips": (FlattenClips(), _equal_length, {}),
     "LowPassFilter": (LowPassFilter(order=4), _motions, {}),
     "FillGaps": (FillGaps(layout="kinect_v1"), _holed_positions, {}),
+    "GestureDetector": (
+        GestureDetector(window=8, random_state=0),
+        _motions,
+        {"scores": lambda est, X: [proba for _, proba in est.scores(X)]},
+    ),
+    "ActivitySegmenter": (
+        ActivitySegmenter(window=8),
+        _motions,
+        {"predict_proba_frames": lambda est, X: est.predict_proba_frames(X)},
+    ),
 }
 
 
