@@ -15,6 +15,7 @@ _SUBPACKAGES = (
     "estimator_checks",
     "io",
     "kinematics",
+    "live",
     "metrics",
     "neighbors",
     "plotting",

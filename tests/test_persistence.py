@@ -15,6 +15,7 @@ from skmotion.base import IncompatibleVersionError, VersionedStateMixin, compati
 from skmotion.control import KMeansPrimitiveController
 from skmotion.datasets import humanoid_skeleton, make_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
+from skmotion.live import ActivitySegmenter, GestureDetector
 from skmotion.neighbors import IntervalIndexNeighbors
 from skmotion.preprocessing import (
     FillGaps,
@@ -24,6 +25,7 @@ from skmotion.preprocessing import (
     ToAeon,
     VirtualMarkerTransform,
 )
+from skmotion.recognition import MotionClassifier
 from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
 from tests.clip_conformance import _as_list, assert_outputs_equal, outputs
 from tests.decomposition.test_eigenmovements import stroke_clips
@@ -68,12 +70,18 @@ CASES = {
         MotionTreeHMM(max_depth=3, min_samples_leaf=4),
         _motions,
         {
-            "decode": _extra("decode"),
+            # decode gives (logprob, paths), as hmmlearn's does
+            "decode": lambda est, X: [est.decode(X)[0], *_as_list(est.decode(X)[1])],
             "predict_next": lambda est, X: [est.predict_next(X, 2).probabilities],
             "novelty_score": _extra("novelty_score"),
         },
     ),
     "MotionTreeEncoder": (MotionTreeEncoder(max_depth=3, layers="all"), _motions, {}),
+    "MotionClassifier": (
+        MotionClassifier(max_depth=3),
+        _motions,
+        {"novelty_score": lambda est, X: [est.novelty_score(X)]},
+    ),
     "IntervalIndexNeighbors": (
         IntervalIndexNeighbors(n_levels=3, n_neighbors=2),
         _motions,
@@ -107,6 +115,16 @@ CASES = {
     "LowPassFilter": (LowPassFilter(order=4), _motions, {}),
     "FillGaps": (FillGaps(layout="kinect_v1"), _holed_positions, {}),
     "ToAeon": (ToAeon(), _motions, {}),
+    "GestureDetector": (
+        GestureDetector(window=8, random_state=0),
+        _motions,
+        {"scores": lambda est, X: [proba for _, proba in est.scores(X)]},
+    ),
+    "ActivitySegmenter": (
+        ActivitySegmenter(window=8),
+        _motions,
+        {"predict_proba_frames": lambda est, X: est.predict_proba_frames(X)},
+    ),
 }
 
 

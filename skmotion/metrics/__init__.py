@@ -1,4 +1,4 @@
-"""Metrics of similarity search and scorers for ``GridSearchCV``.
+"""Metrics of similarity search and of detection in streams; scorers for ``GridSearchCV``.
 
 "Similar" means "has the same label". For a query, the stored clips with its label
 are relevant and the others irrelevant; an index returns a candidate set.
@@ -6,6 +6,7 @@ are relevant and the others irrelevant; an index returns a candidate set.
 
 from skmotion.metrics._candidates import pruning_efficiency, recall
 from skmotion.metrics._ceiling import pruning_ceiling
+from skmotion.metrics._detection import detection_counts, detection_f1
 
 # _SearchScorer is imported here too: scorers pickled before the split name it here.
 from skmotion.metrics._scorers import (
@@ -19,6 +20,8 @@ from skmotion.metrics._scorers import (
 
 __all__ = [
     "SEARCH_SCORES",
+    "detection_counts",
+    "detection_f1",
     "make_pruning_scorer",
     "make_search_scorer",
     "pruning_ceiling",

@@ -1,0 +1,343 @@
+"""MSRC-12 studies of bench_live.py: detection in the stream and frame labelling of long takes.
+
+Protocol: people with odd ids train, people with even ids test (the release's
+cross-subject split); every choice (the event threshold and refractory
+period) by GroupKFold over the training people only, on out-of-fold scores.
+"""
+
+import time
+from pathlib import Path
+
+import numpy as np
+from _common import SHARED_DATA
+from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.linear_model import LogisticRegression, RidgeClassifierCV
+from sklearn.model_selection import GroupKFold
+from sklearn.pipeline import make_pipeline
+from sklearn.preprocessing import StandardScaler
+
+from skmotion.live import ActivitySegmenter, GestureDetector
+from skmotion.live._events import TRIGGERS, TriggerState, next_events
+from skmotion.live._segmenter import runs
+from skmotion.metrics import detection_counts
+from skmotion.preprocessing import FlattenClips, ResampleClips, VirtualMarkerTransform
+from skmotion.tree import MotionTreeEncoder
+
+RATE = 15  # frames per second of the stored MSRC-12
+FIGURE = Path(__file__).resolve().parents[1] / "docs" / "images" / "live_detection.png"
+LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
+THRESHOLDS = np.round(np.linspace(0.05, 0.95, 19), 2)
+REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
+GESTURES = (
+    "lift arms", "duck", "push right", "goggles", "wind it up", "shoot",
+    "bow", "throw", "had enough", "change weapon", "beat both", "kick",
+)  # fmt: skip
+
+
+def msrc12():
+    """Takes (float positions), action points, gestures, person ids; empty takes left out.
+
+    The stored takes lost their untracked (all-zero) frames: the few action points
+    before a take's first frame or past its last are left out."""
+    data = np.load(SHARED_DATA / "msrc12" / "msrc12_sequences.npz")
+    positions, offsets = data["positions"], data["offsets"]
+    points, point_offsets = data["action_points"], data["action_point_offsets"]
+    takes, aps, gestures, people = [], [], [], []
+    for i in range(len(offsets) - 1):
+        take = positions[offsets[i] : offsets[i + 1]].astype(float)
+        if len(take) < 2:
+            continue
+        takes.append(take)
+        found = points[point_offsets[i] : point_offsets[i + 1]].astype(np.intp)
+        aps.append(found[(found >= 0) & (found < len(take))])  # a few fall in removed frames
+        gestures.append(GESTURES[int(data["gesture"][i]) - 1])
+        people.append(int(data["person"][i]))
+    return takes, aps, np.array(gestures, dtype=object), np.array(people)
+
+
+class MiniRocketWindows(ClassifierMixin, BaseEstimator):
+    """The sliding-window peer: aeon's MiniRocket on each window, a ridge classifier's margins.
+
+    MiniRocket (Dempster et al. 2021) with its default 10,000 kernels and its
+    usual classifier (standardised columns, ``RidgeClassifierCV``); the
+    detector turns the margins into probabilities with a softmax (its
+    threshold is chosen on them, as for the recogniser).
+    """
+
+    def fit(self, X, y):
+        from aeon.transformations.collection.convolution_based import MiniRocket
+
+        self.rocket_ = MiniRocket(random_state=0).fit(self._array(X))
+        self.ridge_ = make_pipeline(StandardScaler(), RidgeClassifierCV(np.logspace(-3, 3, 10)))
+        self.ridge_.fit(self.rocket_.transform(self._array(X)), y)
+        self.classes_ = self.ridge_.classes_
+        return self
+
+    @staticmethod
+    def _array(X):
+        return np.stack(X).transpose(0, 2, 1)  # channels first
+
+    def decision_function(self, X):
+        return self.ridge_.decision_function(self.rocket_.transform(self._array(X)))
+
+
+def recognisers():
+    """The recommended recogniser, an ordered one and the peer, all on virtual markers.
+
+    The recommended MotionTreeEncoder describes which poses a window holds, not
+    in which order; the second keeps the order: the window resampled to 10
+    frames, flattened, standardised, a logistic regression (its C fixed, not tuned).
+    """
+    markers = dict(layout="kinect_v1", frame_rate=RATE)
+    return {
+        "skmotion: VirtualMarkerTransform + MotionTreeEncoder + LogisticRegression": make_pipeline(
+            VirtualMarkerTransform(**markers),
+            MotionTreeEncoder(),
+            LogisticRegression(max_iter=2000),
+        ),
+        "skmotion: VirtualMarkerTransform + ResampleClips(10) + FlattenClips + LR": (
+            make_pipeline(
+                VirtualMarkerTransform(**markers),
+                ResampleClips(n_frames=10),
+                FlattenClips(),
+                StandardScaler(),
+                LogisticRegression(C=0.05, max_iter=2000),
+            )
+        ),
+        "aeon MiniRocket (last window) + ridge": make_pipeline(
+            VirtualMarkerTransform(**markers), MiniRocketWindows()
+        ),
+    }
+
+
+def _events(scores, classes, none_index, **rule):
+    return [
+        next_events(ends, proba, classes, none_index, state=TriggerState(), **rule)[0]
+        for ends, proba in scores
+    ]
+
+
+def _f1(counts):
+    tp, fp, fn = (sum(c[i] for c in counts.values()) for i in range(3))
+    return 2 * tp / (2 * tp + fp + fn) if tp else 0.0
+
+
+def _choose(detector, takes, aps, labels, people):
+    """Trigger, threshold and refractory period: the best F1 at 0.5 s on out-of-fold scores."""
+    scores = [None] * len(takes)
+    for fit_idx, held in GroupKFold(3).split(takes, groups=people):
+        model = clone(detector).fit(
+            [takes[i] for i in fit_idx], labels[fit_idx], action_points=[aps[i] for i in fit_idx]
+        )
+        for i, s in zip(held, model.scores([takes[i] for i in held])):
+            scores[i] = s
+    latency = int(round(0.5 * RATE))
+    names = [np.full(len(a), g, dtype=object) for a, g in zip(aps, labels)]
+    best = (-1.0, None)
+    for trigger in TRIGGERS:
+        for refractory in REFRACTORY:
+            for threshold in THRESHOLDS:
+                rule = dict(trigger=trigger, threshold=threshold, refractory=refractory)
+                events = _events(scores, model.classes_, model.none_index_, **rule)
+                f1 = _f1(detection_counts(aps, names, events, latency=latency))
+                if f1 > best[0]:
+                    best = (f1, rule)
+    return best
+
+
+def _cost_per_frame(detector, take, rounds=3):
+    """Microseconds per frame: the stream one frame per call (mean per frame, median of
+    rounds), the median single call (most frames score no window), and detect()."""
+    per_frame, calls = [], []
+    for _ in range(rounds):
+        stream = detector.stream()
+        for frame in take:
+            start = time.perf_counter()
+            stream.update(frame)
+            calls.append(time.perf_counter() - start)
+        per_frame.append(float(np.sum(calls[-len(take) :])) / len(take))
+    start = time.perf_counter()
+    detector.detect([take])
+    batched = (time.perf_counter() - start) / len(take)
+    return 1e6 * float(np.median(per_frame)), 1e6 * float(np.median(calls)), 1e6 * batched
+
+
+def detection(quick, step=2, window=30):
+    """F1 per gesture and latency, both recognisers, with the chosen thresholds."""
+    takes, aps, gestures, people = msrc12()
+    train = np.flatnonzero(people % 2 == 1)
+    test = np.flatnonzero(people % 2 == 0)
+    if quick:
+        train, test = train[::6], test[::6]
+    Xtr, Xte = [takes[i] for i in train], [takes[i] for i in test]
+    names = [np.full(len(aps[i]), gestures[i], dtype=object) for i in test]
+    rows, fitted = [], {}
+    for name, recogniser in recognisers().items():
+        params = dict(
+            recognizer=recogniser, window=window, step=step, n_negatives=10, random_state=0
+        )
+        detector = GestureDetector(**params)
+        start = time.perf_counter()
+        cv_f1, rule = _choose(
+            detector, Xtr, [aps[i] for i in train], gestures[train], people[train]
+        )
+        detector.set_params(**rule)
+        detector.fit(Xtr, gestures[train], action_points=[aps[i] for i in train])
+        fit_s = time.perf_counter() - start
+        events = detector.detect(Xte)
+        fitted[name] = detector
+        stream = detector.stream()  # the stream gives the batch's events (one take checked)
+        streamed = [e for frame in Xte[0] for e in stream.update(frame)]
+        same = [(e.frame, e.label) for e in streamed] == [(e.frame, e.label) for e in events[0]]
+        per_call, median_call, batched = _cost_per_frame(detector, Xte[0][:300])
+        for latency in LATENCIES:
+            for early_name, early in (("+-", None), ("after only", 0)):
+                frames = int(round(latency * RATE))
+                counts = detection_counts(
+                    [aps[i] for i in test], names, events, latency=frames, early=early
+                )
+                row = {
+                    "recogniser": name,
+                    "latency s": latency,
+                    "window": early_name,
+                    "F1": _f1(counts),
+                }
+                row.update({g: _f1({g: counts.get(g, (0, 0, 0))}) for g in GESTURES})
+                row.update(
+                    {
+                        "trigger (CV)": rule["trigger"],
+                        "threshold (CV)": rule["threshold"],
+                        "refractory frames (CV)": rule["refractory"],
+                        "CV F1 at 0.5 s": cv_f1,
+                        "stream events = batch": same,
+                        "us per frame, one per call": per_call,
+                        "us per call, median": median_call,
+                        "us per frame, batched": batched,
+                        "fit + CV s": fit_s,
+                    }
+                )
+                rows.append(row)
+                print({k: row[k] for k in ("recogniser", "latency s", "window", "F1")}, flush=True)
+    figure(fitted, Xte[0], aps[test[0]], gestures[test[0]], FIGURE)
+    return rows
+
+
+def figure(detectors, take, points, gesture, path):
+    """Each recogniser's score over one held-out take, its events and the action points."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(detectors), 1, figsize=(9, 2.1 * len(detectors)), sharex=True)
+    for ax, (name, detector) in zip(np.atleast_1d(axes), detectors.items()):
+        ((ends, proba),) = detector.scores([take])
+        score = np.delete(proba, detector.none_index_, axis=1).max(axis=1)
+        ax.plot(ends / RATE, score, color="tab:blue", lw=1, label="best gesture's probability")
+        ax.axhline(detector.threshold, color="grey", ls=":", lw=1, label="threshold")
+        for k, a in enumerate(points):
+            ax.axvline(a / RATE, color="tab:green", lw=1, label="action point" if k == 0 else None)
+        events = detector.detect([take])[0]
+        right = [e for e in events if e.label == gesture]
+        wrong = [e for e in events if e.label != gesture]
+        ax.plot(
+            [e.frame / RATE for e in right],
+            [e.score for e in right],
+            "v",
+            color="tab:orange",
+            label=f"event: {gesture}",
+        )
+        ax.plot(
+            [e.frame / RATE for e in wrong],
+            [e.score for e in wrong],
+            "x",
+            color="tab:red",
+            label="event: another gesture",
+        )
+        ax.set_ylim(0, 1.05)
+        ax.set_ylabel("probability")
+        ax.set_title(f"{name} (trigger {detector.trigger!r})", fontsize=9)
+    ax.set_xlabel("time (s)")
+    np.atleast_1d(axes)[0].legend(loc="lower left", fontsize=7, ncol=5)
+    fig.tight_layout()
+    path.parent.mkdir(exist_ok=True)
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
+def labelling(quick, window=60, seed=0):
+    """Frame accuracy of ActivitySegmenter on held-out takes of different gestures, concatenated."""
+    takes, _, gestures, people = msrc12()
+    train = np.flatnonzero(people % 2 == 1)
+    test = np.flatnonzero(people % 2 == 0)
+    if quick:
+        train, test = train[::6], test[::6]
+    rng = np.random.default_rng(seed)
+    # per test person, their takes in a shuffled order, four at a time: mostly different gestures
+    long_takes, truth = [], []
+    for person in np.unique(people[test]):
+        own = rng.permutation(test[people[test] == person])
+        for k in range(0, len(own) - 3, 4):
+            parts = own[k : k + 4]
+            long_takes.append(np.concatenate([takes[i] for i in parts]))
+            truth.append(np.concatenate([np.full(len(takes[i]), gestures[i]) for i in parts]))
+    rows = []
+    for name, recogniser in recognisers().items():
+        if "MiniRocket" in name and quick:
+            continue
+        start = time.perf_counter()
+        model = ActivitySegmenter(recogniser, window=window, step=5, train_step=15)
+        model.fit([takes[i] for i in train], gestures[train])
+        fit_s = time.perf_counter() - start
+        start = time.perf_counter()
+        predicted = model.predict_frames(long_takes)
+        frames = int(sum(len(t) for t in long_takes))
+        accuracy = float(np.mean(np.concatenate(predicted) == np.concatenate(truth)))
+        rows.append(
+            {
+                "recogniser": name,
+                "long takes": len(long_takes),
+                "frames": frames,
+                "frame accuracy": accuracy,
+                "segments per take (true: 4)": float(np.mean([len(runs(p)) for p in predicted])),
+                "fit s": fit_s,
+                "us per frame (batch)": 1e6 * (time.perf_counter() - start) / frames,
+            }
+        )
+        print(rows[-1], flush=True)
+    return rows
+
+
+def decoder_stream(quick):
+    """The decoder's online posterior on MSRC-12: MotionTreeHMM().stream() per frame.
+
+    Fitted on the training repetitions (two per take, virtual markers); streamed
+    over held-out takes of virtual markers one frame per call. The label the
+    stream holds at each held-out action point is compared with the take's gesture
+    (the posterior accumulates from the take's start: one gesture per take).
+    """
+    from bench_live import msrc12_repetitions
+
+    from skmotion.tree import MotionTreeHMM
+
+    Xtr, ytr, _, _ = msrc12_repetitions()
+    model = MotionTreeHMM().fit(Xtr, ytr)
+    takes, aps, gestures, people = msrc12()
+    test = np.flatnonzero(people % 2 == 0)[:: 12 if quick else 3]
+    markers = VirtualMarkerTransform(layout="kinect_v1", frame_rate=RATE).fit(takes[:1])
+    hits, per_frame = [], []
+    for i in test:
+        take = markers.transform([takes[i]])[0]
+        stream = model.stream()
+        start = time.perf_counter()
+        labels = [stream.update(frame).label for frame in take]
+        per_frame.append((time.perf_counter() - start) / len(take))
+        hits += [labels[a] == gestures[i] for a in aps[i]]
+    return [
+        {
+            "decoder": "MotionTreeHMM().stream() (online, compiled)",
+            "held-out takes": len(test),
+            "label at the action points = the take's gesture": float(np.mean(hits)),
+            "us per frame, one per call (median over takes)": 1e6 * float(np.median(per_frame)),
+        }
+    ]

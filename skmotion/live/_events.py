@@ -1,0 +1,118 @@
+"""Events from window scores: one decision rule, shared by the batch and the streaming detector.
+
+A detector scores a window every ``step`` frames: one probability per class,
+the "nothing known" class among them; a window's *score* is its best
+motion's probability. Two triggers turn scores into events:
+
+- ``"rise"``: an event at the first window whose score reaches
+  ``threshold`` (the earliest answer; a recogniser that knows a motion before
+  it completes fires early);
+- ``"fall"``: an event when the score falls back below ``threshold`` after a
+  run of windows at or above it, labelled with the run's best motion and
+  score. A window that ends as a motion completes stops matching once the
+  motion is over, so the fall marks the completion; a higher threshold
+  fires sooner (the score drops below it earlier).
+
+In both, an event needs ``refractory`` frames since the last one. The
+threshold trades misses for false alarms and, with the trigger, latency.
+Both the batch ``detect`` and the stream call :func:`next_events` with the
+same state, so they emit the same events from the same scores.
+"""
+
+from typing import NamedTuple
+
+import numpy as np
+
+__all__ = ["Event", "TRIGGERS", "TriggerState", "gesture_scores", "next_events"]
+
+TRIGGERS = ("fall", "rise")
+
+
+class Event(NamedTuple):
+    """A recognised motion: the frame it was emitted at, its label and its score."""
+
+    frame: int
+    label: object
+    score: float
+
+
+class TriggerState(NamedTuple):
+    """What the rule remembers between windows: a few numbers, whatever the stream's length.
+
+    ``last``: the frame of the last event (None: none yet); ``run_best`` and
+    ``run_score``: the best motion's column and score in the current run of
+    windows at or above the threshold (``run_best`` None: no run).
+    """
+
+    last: object = None
+    run_best: object = None
+    run_score: float = -np.inf
+
+
+def gesture_scores(proba, none_index):
+    """Per window: the best gesture's column (never ``none_index``) and its probability."""
+    masked = np.array(proba, dtype=float, copy=True)
+    if none_index is not None:
+        masked[:, none_index] = -np.inf
+    best = np.argmax(masked, axis=1)
+    return best, masked[np.arange(len(masked)), best]
+
+
+def next_events(ends, proba, classes, none_index, *, threshold, refractory, trigger, state):
+    """Events among scored windows, in order, and the rule's state after them.
+
+    Parameters
+    ----------
+    ends : ndarray of int
+        The frame each window ends at (increasing).
+    proba : ndarray of shape (len(ends), n_classes)
+        Class probabilities of each window.
+    classes : ndarray
+        The class of each column.
+    none_index : int or None
+        The column of "nothing known" (never emitted).
+    threshold : float
+        The score that starts (``"rise"``) or whose loss ends (``"fall"``) an event.
+    refractory : int
+        The fewest frames between two events.
+    trigger : {"fall", "rise"}
+    state : TriggerState
+        The state after the previous windows (``TriggerState()`` at the start).
+
+    Returns
+    -------
+    events : list of Event
+    state : TriggerState
+    """
+    best, score = gesture_scores(proba, none_index)
+    above = score >= threshold
+    last, run_best, run_score = state
+    events = []
+    if trigger == "rise":
+        # only the windows at or above the threshold can emit: a short loop, not one per frame
+        for i in np.flatnonzero(above):
+            frame = int(ends[i])
+            if last is None or frame - last >= refractory:
+                events.append(Event(frame, classes[best[i]], float(score[i])))
+                last = frame
+        return events, TriggerState(last, None, -np.inf)
+    # "fall": walk the runs of windows above the threshold, one event at each run's end
+    flips = np.flatnonzero(np.diff(np.r_[run_best is not None, above].astype(np.int8)))
+    start = 0 if run_best is not None else None
+    for i in flips:
+        if start is None:  # a run starts at window i
+            start, run_best, run_score = i, None, -np.inf
+            continue
+        top = start + int(np.argmax(score[start:i])) if i > start else None
+        if top is not None and score[top] > run_score:
+            run_best, run_score = best[top], float(score[top])
+        frame = int(ends[i])  # the first window below the threshold: the run is over
+        if last is None or frame - last >= refractory:
+            events.append(Event(frame, classes[run_best], run_score))
+            last = frame
+        start, run_best, run_score = None, None, -np.inf
+    if start is not None and start < len(score):  # a run still open: remember its best
+        top = start + int(np.argmax(score[start:]))
+        if score[top] > run_score or run_best is None:
+            run_best, run_score = best[top], float(score[top])
+    return events, TriggerState(last, run_best, run_score)

@@ -1,0 +1,92 @@
+"""ActivitySegmenter: frame labels of concatenated clips with known boundaries."""
+
+import numpy as np
+import pytest
+
+from skmotion.datasets import make_motions
+from skmotion.live import ActivitySegmenter
+from skmotion.live._segmenter import _covering_mean, runs
+from skmotion.utils.estimator_checks import ClipCase, parametrize_with_clip_checks
+
+
+def concatenated(X, y, idx, seed):
+    """Takes of four clips each, one after another: frame labels known to the frame."""
+    order = np.random.default_rng(seed).permutation(idx)
+    takes, truth = [], []
+    for k in range(0, len(order) - 3, 4):
+        parts = order[k : k + 4]
+        takes.append(np.concatenate([X[i] for i in parts]))
+        truth.append(np.concatenate([np.full(len(X[i]), y[i], dtype=object) for i in parts]))
+    return takes, truth
+
+
+def test_held_out_subjects_concatenated_clips_are_labelled_frame_by_frame():
+    data = make_motions(n_clips_per_class=8, classes=["walk", "jump", "wave"], random_state=0)
+    X, y, groups = [c[:, 6:] for c in data.clips], data.target_names[data.target], data.groups
+    train, test = np.flatnonzero(groups < 2), np.flatnonzero(groups >= 2)
+    model = ActivitySegmenter(window=20).fit([X[i] for i in train], y[train])
+    takes, truth = concatenated(X, y, test, seed=0)
+    predicted = model.predict_frames(takes)
+    accuracy = np.mean(np.concatenate(predicted) == np.concatenate(truth))
+    assert accuracy >= 0.9
+    for take, segments in zip(takes, model.segments(takes)):  # contiguous, every frame once
+        starts, ends = [s for s, _, _ in segments], [e for _, e, _ in segments]
+        assert starts[0] == 0 and ends[-1] == len(take) and starts[1:] == ends[:-1]
+
+
+def test_per_frame_labels_in_training_and_the_rejection_threshold(rng):
+    low, high = rng.normal(0, 0.1, (300, 2)), rng.normal(1, 0.1, (300, 2))
+    take = np.concatenate([low[:100], high[:100], low[100:200]])
+    labels = np.repeat(np.array(["low", "high", "low"], dtype=object), 100)
+    model = ActivitySegmenter(window=10, step=2).fit([take], [labels])
+    test = np.concatenate([low[200:260], high[200:240], low[260:300]])
+    assert model.segments([test])[0] == [(0, 60, "low"), (60, 100, "high"), (100, 140, "low")]
+    # nothing is sure of itself above 1: every frame is "nothing known"
+    model.set_params(threshold=1.0, none_label="rest")
+    assert set(model.predict_frames([test])[0]) == {"rest"}
+
+
+@pytest.mark.parametrize("n_frames, window, step", [(50, 10, 3), (50, 10, 1), (12, 5, 20)])
+def test_covering_mean_is_the_mean_of_the_windows_over_each_frame(n_frames, window, step, rng):
+    ends = np.arange(window - 1, n_frames, step)
+    proba = rng.random((len(ends), 3))
+    got = _covering_mean(proba, ends, n_frames, window)
+    for f in range(n_frames):
+        over = [i for i, e in enumerate(ends) if e - window + 1 <= f <= e]
+        nearest = min(np.searchsorted(ends, f), len(ends) - 1)
+        expected = proba[over].mean(axis=0) if over else proba[nearest]
+        np.testing.assert_allclose(got[f], expected)
+
+
+def test_runs_by_hand():
+    assert runs(["a", "a", "b", "a"]) == [(0, 2, "a"), (2, 3, "b"), (3, 4, "a")]
+    assert runs([]) == []
+
+
+def test_bad_labels_are_named(rng):
+    take = rng.normal(size=(30, 2))
+    with pytest.raises(ValueError, match="take 0 has 3 frame labels for 30 frames"):
+        ActivitySegmenter().fit([take], [["a", "b", "c"]])
+    with pytest.raises(ValueError, match="2 labels for 1 takes"):
+        ActivitySegmenter().fit([take], ["a", "b"])
+
+
+def motion_clips():
+    data = make_motions(n_clips_per_class=4, classes=["walk", "jump"], random_state=0)
+    return [c[:, 6:] for c in data.clips], data.target_names[data.target]
+
+
+@parametrize_with_clip_checks(
+    [
+        ClipCase(
+            ActivitySegmenter(window=8),
+            motion_clips,
+            skip={
+                "check_cross_val_score": "frame labels are no clip score",
+                "check_grid_search": "frame labels are no clip score",
+            },
+        )
+    ]
+)
+def test_conformance(check):
+    check()
