@@ -74,7 +74,11 @@ def _info(args):
 
     try:
         lines = describe_file(
-            args.file, asf=args.asf, frame_rate=args.frame_rate, skeleton_notes=_marker_preset
+            args.file,
+            asf=args.asf,
+            frame_rate=args.frame_rate,
+            skeleton_notes=_marker_preset,
+            units=None if args.units == "none" else args.units,
         )
     except (OSError, ValueError, ImportError) as exc:
         print(f"skmotion info: {exc}", file=sys.stderr)
@@ -145,6 +149,13 @@ def build_parser():
         type=float,
         default=None,
         help="frames per second of a file that does not record it (keypoint files)",
+    )
+    info.add_argument(
+        "--units",
+        choices=["m", "cm", "mm", "in", "ft", "none"],
+        default="m",
+        help="length unit C3D positions are shown in (default m); 'none' keeps the file's "
+        "numbers, for files whose POINT:UNITS is empty",
     )
     info.set_defaults(func=_info)
     return parser

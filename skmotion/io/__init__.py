@@ -9,12 +9,15 @@ from skmotion.io._errors import MotionFileError
 from skmotion.io._formats import FORMATS, FileFormat, file_format, folder_suffixes
 from skmotion.io._keypoints import read_keypoints
 from skmotion.io._motion import Motion, as_motions
+from skmotion.io._recording import AnalogChannels, MotionEvent
 from skmotion.io._ts import read_ts
 
 __all__ = [
     "FORMATS",
+    "AnalogChannels",
     "FileFormat",
     "Motion",
+    "MotionEvent",
     "MotionFileError",
     "acclaim_order",
     "as_motions",

@@ -87,8 +87,7 @@ FORMATS = (
         "C3D",
         "positions",
         read_c3d,
-        "optical marker positions with residuals",
-        extra="c3d",
+        "optical marker positions with residuals, analog channels, events",
         in_folders=True,
     ),
     FileFormat(
