@@ -323,7 +323,7 @@ def load_motion_folder(folder, index=None, *, channel_layouts="any", verbose=0):
 
     The formats are the rows of :data:`skmotion.io.FORMATS` marked
     ``in_folders`` (:func:`skmotion.io.folder_suffixes`); suffixes match in
-    any case. Reading ``.c3d`` files needs the ``c3d`` extra.
+    any case.
 
     Parameters
     ----------
