@@ -106,7 +106,10 @@ def _parse(name):
         else:
             words.append(t)
     skipped = bool(set(words) & _SKIP)
-    return side, "".join(words), skipped
+    # The longest run of tokens that is a known word ("Character1_LeftUpLeg" -> "upleg").
+    runs = ["".join(words[i:j]) for i in range(len(words)) for j in range(i + 1, len(words) + 1)]
+    known = [r for r in runs if r in _WORDS]
+    return side, max(known, key=len) if known else "".join(words), skipped
 
 
 @dataclass
