@@ -1,5 +1,6 @@
 """Utilities: the clip validator, container conversion, frame stacking, parallelism, progress."""
 
+from skmotion.utils._clip_dataframes import insert_missing_frames
 from skmotion.utils._clips import (
     Clips,
     Container,
@@ -15,6 +16,7 @@ __all__ = [
     "Clips",
     "Container",
     "check_clips",
+    "insert_missing_frames",
     "parallel_map",
     "progress",
     "say",
