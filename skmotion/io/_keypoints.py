@@ -209,7 +209,10 @@ def _as_frames(path, values, names, columns, per_line):
             f"expected numbers of shape (n_frames, n_joints, n_values) or (n_frames, n_columns); "
             f"got {values.dtype} of shape {values.shape}",
         )
-    values = values.astype(float)
+    if 0 in values.shape:
+        raise MotionFileError(path, None, f"no values: an array of shape {values.shape}")
+    with np.errstate(invalid="ignore"):  # float32 signalling NaNs are NaN (missing) too
+        values = values.astype(float)
     if values.ndim == 3:
         return values
     n_joints = len(names) if names is not None else None
