@@ -43,7 +43,7 @@ class Handler(http.server.BaseHTTPRequestHandler):
                 for k in range(0, len(body), 2):
                     self.wfile.write(body[k : k + 2])
                     self.wfile.flush()
-                    time.sleep(0.02)
+                    time.sleep(self.server.trickle_pause)
             else:
                 self.wfile.write(body)
         except OSError:  # the client gave up
@@ -60,7 +60,7 @@ def server(monkeypatch, rng):
     httpd.daemon_threads = True
     httpd.files = {"05.asf": ASF.encode(), "05_01.amc": _amc(_frames(rng, 9)).encode()}
     httpd.plan, httpd.requests, httpd.lock = {}, [], threading.Lock()
-    httpd.content_length = False
+    httpd.content_length, httpd.trickle_pause = False, 0.02
     thread = threading.Thread(target=httpd.serve_forever, daemon=True)
     thread.start()
     monkeypatch.setattr(_fetch, "CMU_URL", f"http://127.0.0.1:{httpd.server_port}/subjects")
@@ -126,16 +126,18 @@ def test_a_killed_fetch_leaves_no_part_file_behind_the_next_one(server, tmp_path
     (tmp_path / "cmu-asfamc" / "05").mkdir(parents=True)
     (tmp_path / "cmu-asfamc" / "05" / "05.asf").write_bytes(server.files["05.asf"])
     server.plan["05_01.amc"] = ["trickle"]
+    server.trickle_pause = 0.2  # minutes for the whole file: the kill comes first
     root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
     child = subprocess.Popen(
         [sys.executable, "-c", textwrap.dedent(_KILLED), _fetch.CMU_URL, str(tmp_path)],
         cwd=root,
     )
     try:
-        for _ in range(300):  # until the download has started
+        deadline = time.monotonic() + 120  # the child imports skmotion first: slow under load
+        while time.monotonic() < deadline and child.poll() is None:
             if any(n.endswith(".part") for n in _cached(tmp_path)):
                 break
-            time.sleep(0.05)
+            time.sleep(0.02)
         assert any(n.endswith(".part") for n in _cached(tmp_path))
     finally:
         child.send_signal(signal.SIGKILL)
