@@ -300,6 +300,14 @@ def read_c3d(path, *, units="m"):
         raise MotionFileError(path, None, f"POINT:RATE is {rate!r}, not a frame rate")
     if n_points == 0:
         raise MotionFileError(path, None, "no 3-D points (POINT:USED is 0)")
+    n_analog = int(meta.number("ANALOG:USED", 0, unsigned=True))
+    if n_analog > 0 and meta.header["analog_per_frame"] % n_analog:
+        raise MotionFileError(
+            path,
+            None,
+            f"the header's {meta.header['analog_per_frame']} analog samples per frame are not "
+            f"a whole number per channel of ANALOG:USED={n_analog}",
+        )
     word = 4 if scale < 0 else 2
     point_bytes = 4 * n_points * word
     frame_bytes = point_bytes + meta.header["analog_per_frame"] * word
