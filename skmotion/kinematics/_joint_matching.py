@@ -13,7 +13,11 @@ the root decides the rest: the wrist's nearest ancestor named like an elbow
 (else its parent) is the elbow, the elbow's nearest ancestor named like an
 upper arm is the shoulder, and so on. Fingers, twist and roll bones and
 helpers never take a role. The trunk comes from the limbs: the chest is
-where the two arms branch, the pelvis where the two legs do.
+where the two arms branch, the pelvis where the two legs do. When the names
+say too little (``bone_07``), the tree alone is read: the first 3-way forks
+from the root are the pelvis and the chest, the chest's two longest
+branches the arms, the pelvis's two others the legs, and left is up x
+forward, forward being the way the feet point in the rest pose.
 """
 
 import re
@@ -158,6 +162,7 @@ class _Tree:
             if p >= 0:
                 self.children[p].append(j)
         self.parsed = [_parse(n) for n in self.names]
+        self.is_end = [not c for c in skeleton.channels]
 
     def ancestors(self, j):
         out = []
@@ -265,7 +270,7 @@ def _trunk(tree, roles, how, rest):
     if heads:
         head = min(heads, key=tree.depth)
         roles["head"], how["head"] = head, "name"
-    elif "chest" in roles:
+    elif "chest" in roles and "head" not in roles:
         # The longest chain from the chest that holds no arm: its last joint with children.
         arm_joints = {j for s in ("left", "right") for j in [roles.get(f"{s}_shoulder")] if j}
         best = None
@@ -297,6 +302,100 @@ def _trunk(tree, roles, how, rest):
             middle = 0.5 * (rest[roles.get("neck_base", roles["chest"])] + rest[roles["pelvis"]])
             spine = min(path, key=lambda j: np.linalg.norm(rest[j] - middle))
             roles["spine"], how["spine"] = spine, "topology"
+
+
+def _leaves(tree, j):
+    return [k for k in [j, *_descendants(tree, j)] if not tree.children[k]]
+
+
+def _fork(tree, j):
+    """The first joint from ``j`` down a chain of single children with 3 or more children."""
+    while len(tree.children[j]) == 1:
+        j = tree.children[j][0]
+    return j if len(tree.children[j]) >= 3 else None
+
+
+def _chain_end(tree, branch, rest, origin):
+    """(end joint, its end site or None) of a limb: where its leaves meet, or its far leaf."""
+    leaves = _leaves(tree, branch)
+    far = max(leaves, key=lambda k: np.linalg.norm(rest[k] - rest[origin]))
+    if len(leaves) > 1:  # fingers or toes: the limb ends where they branch
+        end = far
+        while not set(leaves) <= {end, *_descendants(tree, end)}:
+            end = tree.parents[end]
+        below = [c for c in tree.children[end] if far in (c, *_descendants(tree, c))]
+        return end, below[0]
+    parent = tree.parents[far]
+    return (parent, far) if tree.is_end[far] and parent != origin else (far, None)
+
+
+def _by_topology(tree, rest, roles, how):
+    """Roles from the tree alone (joints named ``j1``, ``bone_07``): the pelvis and chest are
+    the 3-way forks, the arms the chest's two far-reaching branches, the legs the pelvis's
+    two others; left is up x forward, with forward the way the feet point."""
+    pelvis = _fork(tree, 0)
+    if pelvis is None:
+        return False
+    kids = sorted(tree.children[pelvis], key=lambda c: len(_leaves(tree, c)), reverse=True)
+    chest = _fork(tree, kids[0])
+    if chest is None or len(kids) < 3:
+        return False
+
+    def reach(k, origin):
+        """The longest bone path from ``origin`` into branch ``k`` (arms are long even
+        when they hang beside the trunk)."""
+        longest = 0.0
+        for leaf in _leaves(tree, k):
+            length, j = 0.0, leaf
+            while j != origin:
+                length += np.linalg.norm(rest[j] - rest[tree.parents[j]])
+                j = tree.parents[j]
+            longest = max(longest, length)
+        return longest
+
+    legs = sorted(kids[1:], key=lambda c: reach(c, pelvis), reverse=True)[:2]
+    branches = sorted(tree.children[chest], key=lambda c: reach(c, chest), reverse=True)
+    arms, head_branch = branches[:2], branches[2]
+    head, head_end = _chain_end(tree, head_branch, rest, chest)
+    ankles = []
+    for leg in legs:
+        toe, _ = _chain_end(tree, leg, rest, pelvis)
+        ankles.append((tree.parents[toe], toe))
+    up = rest[head] - np.mean([rest[a] for a, _ in ankles], axis=0)
+    forward = np.mean([rest[t] - rest[a] for a, t in ankles], axis=0)
+    forward -= up * (forward @ up) / (up @ up)
+    left = np.cross(up, forward)
+    if np.linalg.norm(forward) < 1e-9 * np.linalg.norm(up):
+        return False  # feet that point nowhere: no facing, so no side
+    sides = {}
+    for group, origin in ((arms, chest), (legs, pelvis)):
+        ordered = sorted(group, key=lambda c: (rest[c] - rest[origin]) @ left, reverse=True)
+        sides.update({ordered[0]: "left", ordered[1]: "right"})
+    for arm in arms:
+        s = sides[arm]
+        wrist, hand_end = _chain_end(tree, arm, rest, chest)
+        elbow = tree.parents[wrist]
+        shoulder = tree.parents[elbow]
+        found = {"wrist": wrist, "elbow": elbow, "shoulder": shoulder, "hand_end": hand_end}
+        if tree.parents[shoulder] != chest:
+            found["clavicle"] = tree.parents[shoulder]
+        roles.update({f"{s}_{k}": v for k, v in found.items() if v is not None})
+    for leg, (ankle, toe) in zip(legs, ankles):
+        s = sides[leg]
+        knee = tree.parents[ankle]
+        roles.update(
+            {
+                f"{s}_toe": toe,
+                f"{s}_ankle": ankle,
+                f"{s}_knee": knee,
+                f"{s}_hip": tree.parents[knee],
+            }
+        )
+    roles["head"] = head
+    if head_end is not None:
+        roles["head_end"] = head_end
+    how.update(dict.fromkeys(roles, "topology"))
+    return True
 
 
 ROLES = ["head", "head_end", "neck", "neck_base", "chest", "spine", "pelvis"] + [
@@ -351,6 +450,12 @@ def match_joints(skeleton):
     rest = skeleton.rest_positions()
     _trunk(tree, roles, how, rest)
     missing = [r for r in REQUIRED if r not in roles]
+    if missing:  # the names say too little: the tree alone
+        topology_roles, topology_how = {}, {}
+        if _by_topology(tree, rest, topology_roles, topology_how):
+            _trunk(tree, topology_roles, topology_how, rest)
+            if all(r in topology_roles for r in REQUIRED):
+                roles, how, missing = topology_roles, topology_how, []
     named = {r: tree.names[j] for r, j in roles.items()}
     if missing:
         found = ", ".join(f"{r}={n}" for r, n in named.items()) or "nothing"

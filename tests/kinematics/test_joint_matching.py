@@ -231,6 +231,8 @@ def make_rig(convention, scale=1.0, up="y"):
         offsets = offsets[:, [0, 2, 1]] * [1, -1, 1]
     rot = ["Zrotation", "Xrotation", "Yrotation"]
     channels = [["Xposition", "Yposition", "Zposition", *rot]] + [rot] * (len(joints) - 1)
+    if "head_end" in slots:  # an end site, as BVH writes one: no channels
+        channels[slots.index("head_end")] = []
     return Skeleton(joints, parents, offsets, channels, up_axis=up), {s: names[s] for s in slots}
 
 
@@ -357,3 +359,33 @@ def test_the_shared_bvh_and_asf_files(shared_data):
         for name in ("left_knee", "right_elbow", "left_shoulder", "right_ankle", "pelvis"):
             k = fixed.names.index(name)
             np.testing.assert_allclose(a[k], b[k], atol=1e-3, err_msg=name)  # CC: Hip vs Pelvis
+
+
+@pytest.mark.parametrize("convention", ["mixamo", "biped", "xsens", "suffix_no_clavicle"])
+def test_topology_alone_when_the_names_say_nothing(convention):
+    """Every joint renamed ``bone_<k>`` in a shuffled order: the tree and the rest pose
+    find the same limbs, and left from up x forward (the feet point forward). Topology
+    alone cannot tell a hand joint below the wrist (CMU's lhand, SMPL's L_Hand, a lone
+    finger with channels) from the
+    wrist, nor a helper branch as long as a leg (Unreal's ik_foot_root) from a leg: those
+    rigs need their names."""
+    skeleton, truth = make_rig(convention)
+    order = np.random.default_rng(3).permutation(skeleton.n_joints - 1) + 1
+    renamed = {name: f"bone_{k:02d}" for name, k in zip(skeleton.joints, [0, *order])}
+    anonymous = Skeleton(
+        [renamed[j] for j in skeleton.joints],
+        skeleton.parents,
+        skeleton.offsets,
+        skeleton.channels,
+    )
+    match = match_joints(anonymous)
+    assert set(match.how.values()) == {"topology"}
+    for side in ("left", "right"):
+        for part in ("shoulder", "elbow", "wrist", "knee", "ankle"):
+            role = f"{side}_{part}"
+            assert match.roles[role] == renamed[truth[role]], role
+    assert match.roles["head"] == renamed[truth["head"]] and match.up_axis == "y"
+    out = VirtualMarkerTransform(skeleton=anonymous, frame_rate=30.0).fit_transform(
+        [np.zeros((3, anonymous.n_channels))]
+    )[0]
+    assert out.shape == (3, 192)
