@@ -230,12 +230,11 @@ def _leg(tree, side, roles, how):
     knee = _up_chain(tree, ankle, _LIMBS["knee"], side, how, f"{side}_knee", roles)
     if knee is not None:
         _up_chain(tree, knee, _LIMBS["hip"], side, how, f"{side}_hip", roles)
-    queue = list(tree.children[ankle])
     toes = [j for j in _descendants(tree, ankle) if tree.is_(j, _LIMBS["toe"])]
     if toes:
         roles[f"{side}_toe"], how[f"{side}_toe"] = toes[0], "name"
-    elif queue:
-        roles[f"{side}_toe"], how[f"{side}_toe"] = queue[0], "topology"
+    elif tree.children[ankle]:
+        roles[f"{side}_toe"], how[f"{side}_toe"] = tree.children[ankle][0], "topology"
 
 
 def _descendants(tree, j):
