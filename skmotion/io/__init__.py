@@ -13,8 +13,8 @@ from skmotion.io._recording import AnalogChannels, MotionEvent
 from skmotion.io._ts import read_ts
 
 __all__ = [
-    "FORMATS",
     "AnalogChannels",
+    "FORMATS",
     "FileFormat",
     "Motion",
     "MotionEvent",
