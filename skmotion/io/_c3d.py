@@ -51,9 +51,11 @@ def _decode_points(raw, processor, scale, n_points):
             words = np.ascontiguousarray(raw).reshape(-1).view(float_type)
         words = words.reshape(n_frames, n_points, 4)
         xyz = words[:, :, :3].astype(np.float64)
-        # A junk fourth word (NaN, huge) counts as invalid rather than overflowing the cast.
+        # A junk fourth word (NaN, huge) counts as invalid rather than overflowing the cast,
+        # and so does a negative fraction (-0.5 would truncate to a valid 0).
         fourth = words[:, :, 3]
-        last = np.where(np.abs(fourth) < 2.0**31, fourth, -1.0).astype(np.int32)
+        usable = (np.abs(fourth) < 2.0**31) & (fourth >= 0)
+        last = np.where(usable, fourth, -1.0).astype(np.int32)
     else:
         words = np.ascontiguousarray(raw).reshape(-1).view(int_type)
         words = words.reshape(n_frames, n_points, 4)
