@@ -76,6 +76,8 @@ def _read_text(path):
     if not any(_is_number(w) for w in words):  # a header names every column
         header, first = words, first + 1
     n_values = len(words)  # every line has as many values as the first
+    if not any(line.split("#", 1)[0].strip() for line in lines[first:]):
+        raise MotionFileError(path, None, "no data lines (a header only)")
     try:
         values = np.loadtxt(
             io.StringIO("\n".join(lines[first:])),
