@@ -6,12 +6,21 @@ per source how many mutated files were tried, rejected with the reader's own
 ``MotionFileError``, read in agreement with a plain-text reference, read equal to the
 original after a layout-only change, and failed (any other outcome: must be 0).
 
-Part 2 writes a large BVH file (``--mb``, default 20; the issue's figure is 100) and
+Part 2 (``bench_fuzz_binary``) runs ``tests/bad_input/binary_fuzz.py``: structure-aware
+mutations of C3D files (header fields, parameter bytes, data bytes, truncation; a
+written file and a real Plug-in Gait file), .npy headers and data, .npz archives and
+keypoint CSV text, each read with a time limit and allocation tracing, and writes per
+source: rejected, agrees (equal to an independent reference), read as the edited file
+states (no independent truth), crashes outside the library's errors, hangs, peak
+allocations past 2x the file's size (plus 1 MB), silent wrong reads (all four must be 0).
+
+Part 3 writes a large BVH file (``--mb``, default 20; the issue's figure is 100) and
 reads it valid and with one error near its end (a word, ``1_000``, a short frame line,
 missing frames, a NUL byte), each in a fresh process, recording seconds and peak
 memory: the error path should cost about what the valid path does.
 
-    python benchmarks/bench_fuzz.py                  # 1,500 cases per source, a 20 MB file
+    python benchmarks/bench_fuzz.py                  # 1,500 (binary: 2,500) cases per source
+    python benchmarks/bench_fuzz.py --binary-cases 10000 --cases 0 --mb 0   # the issue's budget
     python benchmarks/bench_fuzz.py --cases 200 --mb 5   # quick
     python benchmarks/bench_fuzz.py --mb 100         # the issue's size
 """
@@ -27,7 +36,7 @@ from pathlib import Path
 
 from _common import SHARED_DATA, write_results
 
-from tests.bad_input import fuzz
+from tests.bad_input import binary_fuzz, fuzz
 from tests.bad_input.long_inputs import write_long_bvh
 
 _READ = """
@@ -129,13 +138,39 @@ def error_path(megabytes):
     )
 
 
+def binary_counts(n_cases, seed):
+    shared = _shared_data()
+    with tempfile.TemporaryDirectory() as folder:
+        start = time.perf_counter()
+        tally = binary_fuzz.fuzz(Path(folder), shared, n_cases=n_cases, seed=seed)
+        seconds = time.perf_counter() - start
+    rows = [{"source": name, **row} for name, row in sorted(tally.counts.items())]
+    rows.append({"source": "all", **{k: sum(r[k] for r in rows) for k in binary_fuzz.OUTCOMES}})
+    notes = (
+        f"{n_cases} structure-aware mutations per source, seed {seed}, {seconds:.0f} s. "
+        "crash: an exception other than MotionFileError naming the file; hang: no answer in "
+        "5 s; allocation: a peak past 2x the file's size + 1 MB (tracemalloc); wrong: read, "
+        "and different from an independent reference (a plain decode of the data block, "
+        "numpy.load, or the original)."
+    )
+    write_results("bench_fuzz_binary", rows, notes=notes)
+    for failure in tally.failures[:20]:
+        print(failure)
+    return tally
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--cases", type=int, default=1500, help="mutations per source (0: none)")
     parser.add_argument("--seed", type=int, default=2026)
     parser.add_argument("--mb", type=float, default=20.0, help="size of the large BVH file")
+    parser.add_argument(
+        "--binary-cases", type=int, default=2500, help="mutations per binary source (0: none)"
+    )
     args = parser.parse_args()
     failures = fuzz_counts(args.cases, args.seed).failures if args.cases > 0 else []
+    if args.binary_cases > 0:
+        failures += binary_counts(args.binary_cases, args.seed).failures
     if args.mb > 0:
         error_path(args.mb)
     return 1 if failures else 0

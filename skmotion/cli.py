@@ -110,6 +110,7 @@ def _info(args):
                 layout=args.layout,
                 skeleton_notes=_marker_preset,
                 position_notes=notes,
+                units=None if args.units == "none" else args.units,
             )
     except (OSError, ValueError, ImportError, TypeError) as exc:
         print(f"skmotion info: {exc}", file=sys.stderr)
@@ -207,6 +208,13 @@ def build_parser():
         default=None,
         help="the joint order of a keypoint file (kinect_v1, kinect_v2, coco17, ...; a flat "
         "frames x joints*3 file needs it); checks that the order fits the data",
+    )
+    info.add_argument(
+        "--units",
+        choices=["m", "cm", "mm", "in", "ft", "none"],
+        default="m",
+        help="length unit C3D positions are shown in (default m); 'none' keeps the file's "
+        "numbers, for files whose POINT:UNITS is empty",
     )
     info.set_defaults(func=_info)
     return parser

@@ -1,9 +1,12 @@
 """Downloading CMU motion capture subjects into a local cache.
 
 A file enters the cache only whole and readable: it is downloaded to a unique
-temporary name in the cache folder, its size is checked against the server's
-``Content-Length``, it is refused when it is an HTML page, and it is parsed with
-:func:`read_asf` / :func:`read_amc` before :func:`os.replace` gives it its name.
+temporary name in the cache folder (``.part``, with the process id, so that a later
+fetch removes what a killed one left), within a whole-transfer deadline, its size is
+checked against the server's ``Content-Length`` (without one, a second download must
+give the same bytes), it is refused when it is an HTML page, and it is parsed with
+:func:`read_asf` / :func:`read_amc` (every frame complete) before :func:`os.replace`
+gives it its name.
 Transient failures (a cut connection, a timeout, a 5xx answer, a truncated or
 unreadable body) are retried with exponential back-off, then reported as one
 ``ConnectionError`` naming the URL, the last reason and the cache folder.
@@ -11,7 +14,6 @@ unreadable body) are retried with exponential back-off, then reported as one
 
 import http.client
 import os
-import shutil
 import tempfile
 import time
 import urllib.error
@@ -59,16 +61,57 @@ def _looks_like_html(path):
     return head.startswith(_HTML_STARTS)
 
 
-def _attempt(url, target, timeout, check):
-    """Download once into a unique temporary file in the cache folder; return its path."""
+def _copy(response, fh, deadline):
+    """Copy the body, giving up at ``deadline`` (a trickling server never trips the
+    per-read timeout: each read returns a few bytes in time)."""
+    read = getattr(response, "read1", None) or response.read
+    while True:
+        if time.monotonic() > deadline:
+            raise _Retry("the transfer did not finish within transfer_timeout")
+        chunk = read(1 << 16)
+        if not chunk:
+            return
+        fh.write(chunk)
+
+
+def _part_name(target):
+    # The process id in the name lets a later fetch remove what a killed one left.
+    return f".{target.name}.{os.getpid()}."
+
+
+def _remove_orphans(folder):
+    """Remove ``.part`` files of downloads whose process is gone (killed mid-transfer)."""
+    for part in folder.glob(".*.part"):
+        pid = part.name[: -len(".part")].split(".")[-2]
+        if pid.isdigit() and (int(pid) == os.getpid() or _process_alive(int(pid))):
+            continue  # a download running now, in this process or another
+        part.unlink(missing_ok=True)
+
+
+def _process_alive(pid):
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True  # another user's process
+    return True
+
+
+def _attempt(url, target, timeout, check, transfer_timeout):
+    """Download once into a unique temporary file in the cache folder.
+
+    Returns the temporary path and whether the server stated the body's length.
+    """
+    deadline = time.monotonic() + transfer_timeout
     with _urlopen(url, timeout) as response:
         expected = _content_length(response)
         fd, temporary = tempfile.mkstemp(
-            dir=target.parent, prefix=f".{target.name}.", suffix=".part"
+            dir=target.parent, prefix=_part_name(target), suffix=".part"
         )
         try:
             with os.fdopen(fd, "wb") as fh:
-                shutil.copyfileobj(response, fh)
+                _copy(response, fh, deadline)
             size = os.path.getsize(temporary)
             if expected is not None and size != expected:
                 raise _Retry(f"received {size} of {expected} bytes")
@@ -84,17 +127,36 @@ def _attempt(url, target, timeout, check):
         except BaseException:
             os.unlink(temporary)
             raise
-    return temporary
+    return temporary, expected is not None
 
 
-def _download(url, target, timeout, check, verbose=0):
-    """Fetch ``url`` into ``target`` whole and checked; False when the server says 404."""
-    reason = None
-    for attempt in range(_ATTEMPTS):
+def _same_bytes(a, b):
+    with open(a, "rb") as fa, open(b, "rb") as fb:
+        return fa.read() == fb.read()
+
+
+def _download(url, target, timeout, check, verbose=0, transfer_timeout=600.0):
+    """Fetch ``url`` into ``target`` whole and checked; False when the server says 404.
+
+    A body whose length the server does not state (no ``Content-Length``) is
+    kept only when a second download gives the same bytes: a connection that
+    drops between two frames leaves a file that parses, and only a second copy
+    (or a frame count ``check`` knows) can tell.
+    """
+    reason, unconfirmed = None, None
+    for attempt in range(_ATTEMPTS + 1):
         if attempt:
             time.sleep(_BACKOFF * 2 ** (attempt - 1))
         try:
-            temporary = _attempt(url, target, timeout, check)
+            temporary, stated = _attempt(url, target, timeout, check, transfer_timeout)
+            if not stated:
+                if unconfirmed is None or not _same_bytes(unconfirmed, temporary):
+                    if unconfirmed is not None:
+                        os.unlink(unconfirmed)
+                    unconfirmed = temporary
+                    raise _Retry("no Content-Length: a second copy must confirm the length")
+                os.unlink(unconfirmed)
+                unconfirmed = None
         except urllib.error.HTTPError as exc:
             if exc.code == 404:
                 return False
@@ -106,11 +168,19 @@ def _download(url, target, timeout, check, verbose=0):
         except (urllib.error.URLError, http.client.HTTPException, OSError) as exc:
             # URLError (no network, DNS), IncompleteRead, RemoteDisconnected, timeouts, resets.
             reason = str(getattr(exc, "reason", "") or exc) or type(exc).__name__
+        except BaseException:
+            if unconfirmed is not None:
+                os.unlink(unconfirmed)
+            raise
         else:
             os.replace(temporary, target)
             say(verbose, f"downloaded {url}")
             return True
         say(verbose, f"{url}: attempt {attempt + 1} of {_ATTEMPTS} failed ({reason})")
+        if attempt + 1 >= _ATTEMPTS and unconfirmed is None:
+            break
+    if unconfirmed is not None:
+        os.unlink(unconfirmed)
     raise ConnectionError(
         f"Could not download {url} ({reason}) after {_ATTEMPTS} attempts. skmotion needs the "
         f"network to fetch CMU data the first time; offline, place the files in {target.parent} "
@@ -146,10 +216,6 @@ def _subject_trials(subject, trials, index):
 def _verify(folder, skeleton_file, verbose):
     """Re-read every cached file of a subject folder; remove those that do not read."""
     removed = []
-    stale = time.time() - 3600  # a '.part' file this old belongs to no running download
-    for part in folder.glob(".*.part"):
-        if part.stat().st_mtime < stale:
-            part.unlink(missing_ok=True)
     skeleton = None
     if skeleton_file.is_file():
         try:
@@ -173,7 +239,15 @@ def _verify(folder, skeleton_file, verbose):
 
 
 def fetch_cmu_mocap(
-    subjects, *, trials=None, data_home=None, index=None, timeout=30.0, verify=False, verbose=0
+    subjects,
+    *,
+    trials=None,
+    data_home=None,
+    index=None,
+    timeout=30.0,
+    transfer_timeout=600.0,
+    verify=False,
+    verbose=0,
 ):
     """Download CMU subjects' ASF/AMC files into a cache and load them.
 
@@ -201,7 +275,11 @@ def fetch_cmu_mocap(
     index : str, path-like or DataFrame, default=None
         The CMU index CSV, for the trial list, descriptions and frame rates.
     timeout : float, default=30.0
-        Seconds to wait for the server.
+        Seconds to wait for the server (to connect, and for each read).
+    transfer_timeout : float, default=600.0
+        Seconds one whole file may take to arrive; a server that trickles a
+        few bytes at a time never trips ``timeout``, and is given up on (and
+        retried) after this.
     verify : bool, default=False
         Re-read every cached file of the requested subjects first; files that
         do not read (cut, or cached by an older version) are removed and
@@ -236,7 +314,7 @@ def fetch_cmu_mocap(
     index = _as_index(index)
     root = get_data_home(data_home) / "cmu-asfamc"
     for subject in progress(subjects, verbose=verbose, desc="CMU subjects"):
-        _fetch_subject(root, subject, trials, index, timeout, verify, verbose)
+        _fetch_subject(root, subject, trials, index, (timeout, transfer_timeout), verify, verbose)
     data = load_cmu_asfamc(
         root, index, subjects=subjects, errors="raise"
     )  # a bad cache is an error
@@ -246,15 +324,17 @@ def fetch_cmu_mocap(
     return data
 
 
-def _fetch_subject(root, subject, trials, index, timeout, verify, verbose):
+def _fetch_subject(root, subject, trials, index, timeouts, verify, verbose):
     name = f"{subject:02d}"
     folder = root / name
     folder.mkdir(parents=True, exist_ok=True)
+    _remove_orphans(folder)
+    timeout, transfer_timeout = timeouts
     asf = folder / f"{name}.asf"
     if verify:
         _verify(folder, asf, verbose)
     if not asf.is_file() and not _download(
-        f"{CMU_URL}/{name}/{name}.asf", asf, timeout, read_asf, verbose
+        f"{CMU_URL}/{name}/{name}.asf", asf, timeout, read_asf, verbose, transfer_timeout
     ):
         raise ValueError(f"CMU has no subject {subject} ({CMU_URL}/{name}/{name}.asf not found).")
     try:
@@ -268,7 +348,8 @@ def _fetch_subject(root, subject, trials, index, timeout, verify, verbose):
         if amc.is_file():
             return True
         url = f"{CMU_URL}/{name}/{amc.name}"
-        return _download(url, amc, timeout, lambda path: read_amc(path, skeleton), verbose)
+        check = lambda path: read_amc(path, skeleton)  # noqa: E731
+        return _download(url, amc, timeout, check, verbose, transfer_timeout)
 
     wanted = _subject_trials(subject, trials, index)
     if wanted is None:

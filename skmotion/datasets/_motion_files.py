@@ -431,7 +431,7 @@ def load_motion_folder(
 
     The formats are the rows of :data:`skmotion.io.FORMATS` marked
     ``in_folders`` (:func:`skmotion.io.folder_suffixes`); suffixes match in
-    any case. Reading ``.c3d`` files needs the ``c3d`` extra. With
+    any case. With
     ``layout=``, keypoint files (``.npy``, ``.npz``, ``.csv``, ``.txt``:
     joint positions per frame, see :func:`skmotion.io.read_keypoints`) are
     read too, in that layout's joint order, and the order is checked against

@@ -14,14 +14,17 @@ __getattr__, __dir__ = attach(
         "skmotion.io._formats": ["FORMATS", "FileFormat", "file_format", "folder_suffixes"],
         "skmotion.io._keypoints": ["read_keypoints"],
         "skmotion.io._motion": ["Motion", "as_motions"],
+        "skmotion.io._recording": ["AnalogChannels", "MotionEvent"],
         "skmotion.io._ts": ["read_ts"],
     },
 )
 
 __all__ = [
+    "AnalogChannels",
     "FORMATS",
     "FileFormat",
     "Motion",
+    "MotionEvent",
     "MotionFileError",
     "acclaim_order",
     "as_motions",

@@ -29,7 +29,11 @@ def _header(path, data):
                 path, number, f"bone data before the first frame number: {word.split(' ')[0]!r}"
             )
         if word.upper() in (":DEGREES", ":RADIANS"):
-            unit = "deg" if word.upper() == ":DEGREES" else "rad"
+            said = "deg" if word.upper() == ":DEGREES" else "rad"
+            if unit is not None and said != unit:
+                # A 57x difference: neither keyword may silently win.
+                raise MotionFileError(path, number, "both :DEGREES and :RADIANS: which unit?")
+            unit = said
     return unit, found.start(), data.count(b"\n", 0, found.start()) + 1
 
 
@@ -102,8 +106,8 @@ def read_amc(path, skeleton, *, frame_rate=120.0):
     MotionFileError
         For an unknown bone, a bone line with the wrong number of values, a
         frame missing a bone or listing it twice (a truncated file), frame
-        numbers out of sequence or non-numeric values; the message names the
-        file and the line.
+        numbers out of sequence, non-numeric values, a header saying both
+        ``:DEGREES`` and ``:RADIANS``; the message names the file and the line.
 
     Examples
     --------

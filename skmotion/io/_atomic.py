@@ -1,6 +1,7 @@
 """Writing a file so that it is either complete or not there: a temporary name, then a rename."""
 
 import contextlib
+import errno
 import os
 import tempfile
 from pathlib import Path
@@ -28,6 +29,10 @@ def atomic_writer(path, *, encoding="utf-8"):
     file systems), is flushed to disk, and is renamed over ``path`` with
     :func:`os.replace`. If anything fails on the way (disk full, an exception, an
     interrupt) the temporary file is removed and ``path`` keeps its old content.
+    A symlink is written through (its target gets the content, the link stays);
+    a read-only file is refused (:class:`PermissionError`), even for a user who
+    could override its mode; every :class:`OSError` names ``path``, never the
+    temporary file.
 
     Parameters
     ----------
@@ -51,17 +56,27 @@ def atomic_writer(path, *, encoding="utf-8"):
     ...     open(path).read(), os.listdir(folder)
     ('complete\\n', ['a.txt'])
     """
-    path = Path(path)
-    mode = path.stat().st_mode & 0o777 if path.is_file() else _default_mode()
-    fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    shown = str(path)
+    # Write through a symlink to its target: the link stays a link.
+    path = Path(os.path.realpath(path))
+    exists = path.is_file()
+    mode = path.stat().st_mode & 0o777 if exists else _default_mode()
+    if exists and (not mode & 0o222 or not os.access(path, os.W_OK)):
+        raise PermissionError(errno.EACCES, "the file is read-only; not overwritten", shown)
+    temporary = None
     try:
+        fd, temporary = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
         with os.fdopen(fd, "w", encoding=encoding, newline="\n") as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
         os.chmod(temporary, mode)
         os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
+    except BaseException as exc:
+        if temporary is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(temporary)
+        if isinstance(exc, OSError) and exc.errno is not None:
+            # The error names the user's path, not the hidden temporary file.
+            raise type(exc)(exc.errno, exc.strerror, shown) from None
         raise

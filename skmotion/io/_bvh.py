@@ -18,7 +18,7 @@ from skmotion.io._text import (
     parse_number,
     read_text,
 )
-from skmotion.kinematics import Skeleton, forward_kinematics
+from skmotion.kinematics import Skeleton, forward_kinematics, match_joints
 
 __all__ = ["detect_up_axis", "read_bvh"]
 
@@ -88,6 +88,14 @@ def detect_up_axis(skeleton, channels, *, max_frames=25):
     positions = forward_kinematics(skeleton, channels[frames]).positions
     extents = np.median(positions.max(axis=1) - positions.min(axis=1), axis=0)
     return "xyz"[int(np.argmax(extents))]
+
+
+def _up_axis(skeleton, channels):
+    """Head above feet in the rest pose; the largest extent over the clip for a non-humanoid."""
+    try:
+        return match_joints(skeleton).up_axis
+    except ValueError:
+        return detect_up_axis(skeleton, channels)
 
 
 _HEADER = re.compile(
@@ -209,8 +217,11 @@ def read_bvh(path, *, up_axis=None):
         The ``.bvh`` file.
     up_axis : {"x", "y", "z"}, default=None
         The vertical axis of the file's world. BVH files do not record it; by
-        default it is detected as the axis of the figure's largest extent in
-        the first frame (see :func:`detect_up_axis`).
+        default it is the axis along which the rest pose's head is farthest
+        from its feet, when :func:`~skmotion.kinematics.match_joints` finds
+        them (the same answer for every file of one skeleton), else the
+        axis of the figure's largest extent over the clip
+        (:func:`detect_up_axis`).
 
     Returns
     -------
@@ -281,5 +292,5 @@ def read_bvh(path, *, up_axis=None):
     channels, frame_rate = _motion_block(path, data, start, skeleton.n_channels)
     rotations = np.array([name.endswith("rotation") for name in skeleton.channel_names])
     channels[:, rotations] = np.deg2rad(channels[:, rotations])
-    skeleton = dataclasses.replace(skeleton, up_axis=up_axis or detect_up_axis(skeleton, channels))
+    skeleton = dataclasses.replace(skeleton, up_axis=up_axis or _up_axis(skeleton, channels))
     return Motion(skeleton, channels, frame_rate=frame_rate, source=str(path))

@@ -216,6 +216,13 @@ def write_bvh(motion, path, *, precision=None):
         break or blanks at its ends (spaces inside a name are kept); a NaN or
         infinite channel value (naming its frame and channel); no frames; no
         channels.
+    PermissionError
+        ``path`` is a read-only file: it is not overwritten (write elsewhere,
+        or make it writable first).
+    OSError
+        The folder is missing or not writable, the disk is full, ...; the
+        message names ``path``. ``path`` keeps its old content. A symlink is
+        written through: its target gets the new content.
 
     See Also
     --------

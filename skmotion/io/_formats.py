@@ -102,8 +102,7 @@ FORMATS = (
         "C3D",
         "positions",
         "skmotion.io._c3d:read_c3d",
-        "optical marker positions with residuals",
-        extra="c3d",
+        "optical marker positions with residuals, analog channels, events",
         in_folders=True,
     ),
     FileFormat(

@@ -47,6 +47,19 @@ def _position_lines(motion, rate_known):
         f"{int(missing.all(axis=0).sum())} markers never seen",
     ]
     lines += [f"extras: {', '.join(motion.extras)}"] if motion.extras else []
+    if motion.analog is not None:
+        analog = motion.analog
+        lines.append(
+            f"analog: {len(analog.labels)} channels at {analog.rate:g} Hz: "
+            + _shown(list(analog.labels))
+        )
+    if motion.events:
+        counts = Counter(f"{e.context} {e.label}".strip() for e in motion.events)
+        lines.append(
+            f"events: {len(motion.events)} ("
+            + ", ".join(f"{k} x{n}" for k, n in sorted(counts.items()))
+            + ")"
+        )
     if rate_known:
         return lines + [_frames_line(motion)]
     return lines + [f"frames: {motion.n_frames} (no frame rate in the file; give --frame-rate)"]
@@ -84,7 +97,14 @@ def _find_skeleton(amc, suffix):
 
 
 def describe_file(
-    path, *, asf=None, frame_rate=None, layout=None, skeleton_notes=None, position_notes=None
+    path,
+    *,
+    asf=None,
+    frame_rate=None,
+    layout=None,
+    skeleton_notes=None,
+    position_notes=None,
+    units="m",
 ):
     """The lines ``skmotion info`` prints for a motion file of any format in :data:`FORMATS`.
 
@@ -105,6 +125,9 @@ def describe_file(
     position_notes : callable, default=None
         ``position_notes(motion)`` gives further lines about a position
         motion (the command adds its check of ``layout``).
+    units : {"m", "cm", "mm", "in", "ft"} or None, default="m"
+        Length unit a C3D file's positions are converted to; None keeps the
+        file's numbers (a file whose ``POINT:UNITS`` is empty).
 
     Returns
     -------
@@ -144,6 +167,8 @@ def describe_file(
         head[1] += f", skeleton {asf}; frame rate not recorded in AMC files: CMU's 120 Hz"
     elif row.needs_frame_rate:
         motion = row.reader(path, layout, frame_rate=frame_rate or 1.0)
+    elif row.kind == "positions":
+        motion = row.reader(path, units=units)
     else:
         motion = row.reader(path)
     if motion.kind == "positions":

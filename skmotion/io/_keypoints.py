@@ -6,6 +6,7 @@ object with a ``joints`` or ``joint_names`` sequence, or a layout name that
 """
 
 import io
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -75,6 +76,8 @@ def _read_text(path):
     if not any(_is_number(w) for w in words):  # a header names every column
         header, first = words, first + 1
     n_values = len(words)  # every line has as many values as the first
+    if not any(line.split("#", 1)[0].strip() for line in lines[first:]):
+        raise MotionFileError(path, None, "no data lines (a header only)")
     try:
         values = np.loadtxt(
             io.StringIO("\n".join(lines[first:])),
@@ -92,26 +95,95 @@ def _read_text(path):
     return values, header
 
 
+def _array_header(path, handle, available, where):
+    """(shape, fortran order, dtype) of the ``.npy`` stream ``handle``, checked against
+    the ``available`` bytes before anything is allocated."""
+    start = handle.tell()
+    version = np.lib.format.read_magic(handle)
+    read_header = {
+        (1, 0): np.lib.format.read_array_header_1_0,
+        (2, 0): np.lib.format.read_array_header_2_0,
+    }.get(version)
+    if read_header is None:
+        raise MotionFileError(path, None, f"{where}: .npy format version {version} is not read")
+    shape, fortran, dtype = read_header(handle, max_header_size=10000)
+    if dtype.hasobject or dtype.names is not None or dtype.kind not in "fiubUS":
+        raise MotionFileError(path, None, f"{where}: holds {dtype} values, not numbers")
+    needed = int(np.prod(shape, dtype=object)) * dtype.itemsize
+    have = available - (handle.tell() - start)
+    if needed > have:
+        raise MotionFileError(
+            path,
+            None,
+            f"{where}: the header announces {shape} {dtype} ({needed} bytes); "
+            f"the file holds {have}",
+        )
+    return shape, fortran, dtype
+
+
+def _load_array(path, handle, available, where):
+    shape, fortran, dtype = _array_header(path, handle, available, where)
+    count = int(np.prod(shape, dtype=np.int64))
+    data = handle.read(count * dtype.itemsize)
+    if len(data) != count * dtype.itemsize:
+        raise MotionFileError(path, None, f"{where}: the data is cut short")
+    order = "F" if fortran else "C"
+    return np.frombuffer(data, dtype=dtype, count=count).reshape(shape, order=order)
+
+
+def _npz_members(path, archive):
+    """The arrays of an ``.npz`` archive, each checked before it is read."""
+    arrays = {}
+    for info in archive.infolist():
+        name = info.filename[:-4] if info.filename.endswith(".npy") else info.filename
+        # Deflate cannot expand more than about 1032:1: a larger claim is a forged size.
+        if (
+            info.compress_type != zipfile.ZIP_STORED
+            and info.file_size > 1100 * info.compress_size + 1024
+        ):
+            raise MotionFileError(path, None, f"array {name!r}: implausible uncompressed size")
+        with archive.open(info) as member:
+            arrays[name] = _load_array(path, member, info.file_size, f"array {name!r}")
+    return arrays
+
+
 def _read_array(path):
-    """(values, joint names or None, confidence or None) of a ``.npy`` or ``.npz`` file."""
+    """(values, joint names or None, confidence or None) of a ``.npy`` or ``.npz`` file.
+
+    The arrays are read without pickles, and every header is checked against
+    the bytes the file holds before any allocation. Whatever goes wrong in the
+    bytes (a damaged zip, a garbled header) is a :class:`MotionFileError`.
+    """
+    size = Path(path).stat().st_size  # a missing file: the OSError names it
     try:
-        loaded = np.load(path, allow_pickle=False)
-    except (ValueError, OSError) as exc:
-        raise MotionFileError(path, None, f"not a NumPy array file ({exc})") from None
-    if not isinstance(loaded, np.lib.npyio.NpzFile):
-        return loaded, None, None
-    with loaded:
-        keys = set(loaded.files)
-        main = [k for k in ("keypoints", "positions") if k in keys]
-        if not main:
-            main = sorted(keys - {"confidence", "joint_names"})
-        if len(main) != 1:
+        with open(path, "rb") as handle:
+            if handle.read(2) == b"PK":
+                with zipfile.ZipFile(handle) as archive:
+                    arrays = _npz_members(path, archive)
+            else:
+                handle.seek(0)
+                return _load_array(path, handle, size, "array"), None, None
+    except MotionFileError:
+        raise
+    except Exception as exc:  # BadZipFile, zlib.error, a header's SyntaxError/TokenError ...
+        raise MotionFileError(
+            path, None, f"not a readable NumPy array file ({type(exc).__name__}: {exc})"
+        ) from None
+    main = [k for k in ("keypoints", "positions") if k in arrays]
+    if not main:
+        main = sorted(set(arrays) - {"confidence", "joint_names"})
+    if len(main) != 1:
+        raise MotionFileError(
+            path, None, f"expected an array 'keypoints' (or one array); found {sorted(arrays)}"
+        )
+    names = arrays.get("joint_names")
+    if names is not None:
+        if names.ndim != 1 or names.dtype.kind not in "U":
             raise MotionFileError(
-                path, None, f"expected an array 'keypoints' (or one array); found {sorted(keys)}"
+                path, None, f"joint_names is {names.dtype} {names.shape}, not text"
             )
-        names = loaded["joint_names"].tolist() if "joint_names" in keys else None
-        confidence = loaded["confidence"] if "confidence" in keys else None
-        return loaded[main[0]], names, confidence
+        names = names.tolist()
+    return arrays[main[0]], names, arrays.get("confidence")
 
 
 def _joints_from_header(path, header, n_values):
@@ -139,7 +211,10 @@ def _as_frames(path, values, names, columns, per_line):
             f"expected numbers of shape (n_frames, n_joints, n_values) or (n_frames, n_columns); "
             f"got {values.dtype} of shape {values.shape}",
         )
-    values = values.astype(float)
+    if 0 in values.shape:
+        raise MotionFileError(path, None, f"no values: an array of shape {values.shape}")
+    with np.errstate(invalid="ignore"):  # float32 signalling NaNs are NaN (missing) too
+        values = values.astype(float)
     if values.ndim == 3:
         return values
     n_joints = len(names) if names is not None else None

@@ -4,6 +4,7 @@ from numbers import Real
 
 import numpy as np
 
+from skmotion.io._recording import AnalogChannels
 from skmotion.kinematics import Skeleton, forward_kinematics
 
 __all__ = ["Motion", "as_motions"]
@@ -48,6 +49,12 @@ class Motion:
         Further per-frame data kept from the file, each array with
         ``n_frames`` rows: a C3D file's ``"residuals"``, a keypoint file's
         ``"confidence"`` (one column per marker).
+    analog : AnalogChannels, default=None
+        Analog channels recorded with the motion (a C3D file's force plates
+        and EMG), at their own rate.
+    events : sequence of MotionEvent, default=()
+        Labelled instants (a C3D file's foot strikes and toe-offs), in time
+        order.
 
     Attributes
     ----------
@@ -99,6 +106,8 @@ class Motion:
         marker_names=None,
         units=None,
         extras=None,
+        analog=None,
+        events=(),
     ):
         channels = np.array(channels, dtype=float, order="C")
         if skeleton is None:
@@ -128,6 +137,10 @@ class Motion:
         self.marker_names = marker_names
         self.units = (skeleton.units if skeleton is not None else None) or units or "unknown"
         self.extras = _check_extras(extras, len(channels))
+        if analog is not None and not isinstance(analog, AnalogChannels):
+            raise TypeError(f"analog must be AnalogChannels or None, got {type(analog).__name__}.")
+        self.analog = analog
+        self.events = tuple(sorted(events, key=lambda e: e.time))
 
     @property
     def channel_names(self):

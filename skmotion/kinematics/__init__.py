@@ -7,6 +7,7 @@ __getattr__, __dir__ = attach(
     {
         "skmotion.kinematics._body_size": ["body_size"],
         "skmotion.kinematics._forward": ["FKResult", "forward_kinematics"],
+        "skmotion.kinematics._joint_matching": ["JointMatch", "match_joints"],
         "skmotion.kinematics._layout_check": ["check_layout"],
         "skmotion.kinematics._layouts": ["Layout"],
         "skmotion.kinematics._marker_names": ["MARKER_NAMES"],
@@ -24,6 +25,7 @@ __getattr__, __dir__ = attach(
 __all__ = [
     "CHANNEL_KINDS",
     "FKResult",
+    "JointMatch",
     "LAYOUTS",
     "Layout",
     "MARKER_NAMES",
@@ -34,6 +36,7 @@ __all__ = [
     "euler_to_matrix",
     "forward_kinematics",
     "get_layout",
+    "match_joints",
     "matrix_to_euler",
     "yaw_matrix",
 ]

@@ -8,7 +8,9 @@ subject. Clips of different skeletons then share one feature space.
 
 import numpy as np
 
+from skmotion.kinematics._joint_matching import match_joints
 from skmotion.kinematics._marker_names import MARKER_NAMES
+from skmotion.preprocessing._marker_matching import matched_marker_set
 from skmotion.preprocessing._marker_set import MarkerSet
 
 __all__ = ["MARKER_NAMES", "MARKER_PRESETS", "detect_marker_preset", "marker_preset"]
@@ -159,8 +161,9 @@ _PRESETS = {
         _humanoid,
     ),
 }
-#: Preset names, in the order :func:`detect_marker_preset` tries them.
-MARKER_PRESETS = ("cmu_asf", "character_creator", "humanoid", "common_bvh")
+#: Preset names, in the order :func:`detect_marker_preset` tries them; ``"matched"`` places
+#: the markers on the joints :func:`~skmotion.kinematics.match_joints` finds (any humanoid).
+MARKER_PRESETS = ("cmu_asf", "character_creator", "humanoid", "common_bvh", "matched")
 
 
 def _spec_joints(spec):
@@ -179,6 +182,10 @@ def _required_joints(preset):
 def detect_marker_preset(skeleton):
     """The name of the first preset whose joints the skeleton has all of.
 
+    A skeleton of no known family gets ``"matched"`` when
+    :func:`~skmotion.kinematics.match_joints` finds its head, trunk and
+    limbs by joint names and topology.
+
     Parameters
     ----------
     skeleton : Skeleton
@@ -191,7 +198,8 @@ def detect_marker_preset(skeleton):
     Raises
     ------
     ValueError
-        When no preset fits; give a :class:`MarkerSet` then.
+        When no preset fits and the matcher finds no humanoid; give a
+        :class:`MarkerSet` then.
 
     Examples
     --------
@@ -201,17 +209,15 @@ def detect_marker_preset(skeleton):
     'humanoid'
     """
     joints = set(skeleton.joints)
-    for preset in MARKER_PRESETS:
+    tables = [p for p in MARKER_PRESETS if p in _PRESETS]
+    for preset in tables:
         if _required_joints(preset) <= joints:
             return preset
-    closest = min(MARKER_PRESETS, key=lambda p: len(_required_joints(p) - joints))
-    missing = sorted(_required_joints(closest) - joints)
-    raise ValueError(
-        f"No marker preset fits this skeleton (root {skeleton.joints[0]!r}, "
-        f"{skeleton.n_joints} joints); the closest, {closest!r}, lacks joints "
-        f"{missing[:6]}{' ...' if len(missing) > 6 else ''}. "
-        "Define the markers with a MarkerSet."
-    )
+    try:
+        match_joints(skeleton)
+    except ValueError as exc:
+        raise ValueError(f"No marker preset fits this skeleton: {exc}") from None
+    return "matched"
 
 
 def _offset(skeleton, spec):
@@ -240,7 +246,8 @@ def marker_preset(skeleton, preset=None):
         A skeleton of one of the preset families: the CMU ASF skeleton
         (``cmu_asf``), the Character Creator ``CC_Base_*`` skeleton
         (``character_creator``), the built-in humanoid (``humanoid``) or the
-        common ``Hips/Spine/LeftUpLeg`` BVH naming (``common_bvh``).
+        common ``Hips/Spine/LeftUpLeg`` BVH naming (``common_bvh``); any
+        other humanoid through the joint matcher (``matched``).
     preset : str, default=None
         The preset; by default detected from the joint names
         (:func:`detect_marker_preset`).
@@ -266,6 +273,8 @@ def marker_preset(skeleton, preset=None):
     """
     if preset is None:
         preset = detect_marker_preset(skeleton)
+    if preset == "matched":
+        return matched_marker_set(skeleton, match_joints(skeleton))
     if preset not in _PRESETS:
         raise ValueError(
             f"Unknown marker preset {preset!r}; expected one of {list(MARKER_PRESETS)}."

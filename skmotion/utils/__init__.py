@@ -5,6 +5,7 @@ from skmotion._lazy import attach
 __getattr__, __dir__ = attach(
     __name__,
     {
+        "skmotion.utils._clip_dataframes": ["insert_missing_frames"],
         "skmotion.utils._clips": [
             "Clips",
             "Container",
@@ -25,6 +26,7 @@ __all__ = [
     "check_clips",
     "from_aeon",
     "from_tslearn",
+    "insert_missing_frames",
     "parallel_map",
     "progress",
     "say",

@@ -66,9 +66,82 @@ def split_dataframe(X, input_name):
                 f"{input_name}: frames of clip {_label(clip_label)} are not strictly "
                 f"increasing (at frame label {_label(frame_values[row])}); sort the index."
             )
+        _check_no_gap(input_name, frame_values, starts, labels, codes)
     values = X.to_numpy()
     clips = np.split(values, starts[1:])
     return clips, pd.Index(labels), tuple(index.names), X.columns
+
+
+def _check_no_gap(input_name, frames, starts, labels, codes):
+    """Integer frame labels must run without a hole within each clip.
+
+    A missing frame is not closed silently (velocities, filters and gap filling
+    would run across the hole as if no time had passed): it is an error that
+    says how to mark the frames missing, as NaN rows that FillGaps can fill.
+    Other frame labels (timestamps, floats) are only required to increase.
+    """
+    if frames.dtype.kind not in "iu":
+        return
+    step = np.diff(frames)
+    step[starts[1:] - 1] = 1
+    if (step == 1).all():
+        return
+    row = int(np.flatnonzero(step != 1)[0])
+    clip_label = labels[codes[row]]
+    before, after = frames[row].item(), frames[row + 1].item()
+    raise ValueError(
+        f"{input_name}: clip {_label(clip_label)} jumps from frame {before} to frame {after} "
+        f"({after - before - 1} frames missing); frames are not closed up silently. To mark "
+        "them missing, skmotion.utils.insert_missing_frames(df) adds a NaN row per missing "
+        "frame, which FillGaps can fill."
+    )
+
+
+def insert_missing_frames(X):
+    """A NaN row for every frame missing from a clip's integer frame labels.
+
+    skmotion refuses a (clip, frame) DataFrame whose frame labels skip
+    (``0, 1, 4``): closing the hole silently would let velocities, filters and
+    gap filling run across it as if no time had passed. This makes the hole
+    explicit instead: missing values that
+    :class:`~skmotion.preprocessing.FillGaps` fills, or that an estimator
+    which cannot take NaN refuses with a clear error.
+
+    Parameters
+    ----------
+    X : DataFrame
+        A collection with a two-level (clip, frame) MultiIndex and integer
+        frame labels, increasing within each clip.
+
+    Returns
+    -------
+    filled : DataFrame
+        Each clip's rows for every frame from its first label to its last,
+        NaN where the frame was missing; clips in their original order.
+
+    Examples
+    --------
+    >>> import numpy as np, pandas as pd
+    >>> from skmotion.utils import insert_missing_frames
+    >>> index = pd.MultiIndex.from_tuples([("a", 0), ("a", 1), ("a", 3), ("b", 5)],
+    ...                                   names=["clip", "frame"])
+    >>> df = pd.DataFrame({"x": [0.0, 1.0, 3.0, 5.0]}, index=index)
+    >>> insert_missing_frames(df)["x"].tolist()
+    [0.0, 1.0, nan, 3.0, 5.0]
+    """
+    clips, frames = X.index.get_level_values(0), X.index.get_level_values(1)
+    if frames.dtype.kind not in "iu":
+        raise ValueError(
+            f"frame labels must be integers to find missing frames; got {frames.dtype}."
+        )
+    labels = pd.unique(clips)
+    frame = pd.Series(np.asarray(frames), index=clips)
+    first, last = frame.groupby(level=0, sort=False).min(), frame.groupby(level=0, sort=False).max()
+    full = pd.MultiIndex.from_tuples(
+        [(c, f) for c in labels for f in range(int(first[c]), int(last[c]) + 1)],
+        names=X.index.names,
+    )
+    return X.reindex(full)
 
 
 def _feature_names(X):

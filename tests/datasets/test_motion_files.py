@@ -123,7 +123,9 @@ class FakeServer:
         name = url.rsplit("/", 1)[1]
         if name not in self.files:
             raise urllib.error.HTTPError(url, 404, "Not Found", {}, None)
-        return io.BytesIO(self.files[name].encode())
+        body = io.BytesIO(self.files[name].encode())
+        body.headers = {"Content-Length": str(len(body.getvalue()))}  # as a real server states
+        return body
 
 
 def test_fetch_downloads_then_reuses_the_cache(tmp_path, rng, monkeypatch):

@@ -61,14 +61,25 @@ def test_info_on_keypoints_and_series(tmp_path, capsys):
     assert "unknown motion file type '.fbx'" in capsys.readouterr().err
 
 
-def test_without_the_c3d_extra_the_error_names_it(tmp_path, monkeypatch, capsys):
+def test_c3d_files_need_no_optional_package(tmp_path, monkeypatch, capsys):
+    """read_c3d parses the file itself: with the c3d package hidden, a file reads, and a
+    broken one is the reader's own error in read_c3d, skmotion info and the folder loader."""
+    from tests.io.c3d_files import c3d_bytes
+
     monkeypatch.setitem(sys.modules, "c3d", None)
-    (tmp_path / "t.c3d").write_bytes(b"\x02P" + bytes(510))
-    with pytest.raises(ImportError, match=r"pip install 'skmotion\[c3d\]'"):
-        io.read_c3d(tmp_path / "t.c3d")
-    assert main(["info", str(tmp_path / "t.c3d")]) == 1
-    assert "skmotion[c3d]" in capsys.readouterr().err
-    with pytest.raises(ImportError, match=r"skmotion\[c3d\]"):
+    monkeypatch.setitem(sys.modules, "ezc3d", None)
+    (tmp_path / "walk").mkdir()
+    (tmp_path / "walk" / "t.c3d").write_bytes(c3d_bytes(np.ones((4, 2, 3))))
+    assert io.read_c3d(tmp_path / "walk" / "t.c3d", units=None).channels.tolist() == [[1.0] * 6] * 4
+    assert main(["info", str(tmp_path / "walk" / "t.c3d")]) == 0
+    assert "markers: 2 (3-D, length unit m)" in capsys.readouterr().out
+    assert len(load_motion_folder(tmp_path).clips) == 1
+    (tmp_path / "walk" / "t.c3d").write_bytes(b"\x02P" + bytes(510))
+    with pytest.raises(io.MotionFileError, match=r"t\.c3d: the parameter section"):
+        io.read_c3d(tmp_path / "walk" / "t.c3d")
+    assert main(["info", str(tmp_path / "walk" / "t.c3d")]) == 1
+    assert "the parameter section (block 2) is missing" in capsys.readouterr().err
+    with pytest.raises(io.MotionFileError, match=r"t\.c3d"):
         load_motion_folder(tmp_path)
 
 

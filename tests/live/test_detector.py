@@ -7,10 +7,10 @@ from sklearn.frozen import FrozenEstimator
 from sklearn.pipeline import make_pipeline
 from sklearn.svm import LinearSVC
 
+from skmotion.estimator_checks import ClipCase, parametrize_with_clip_checks
 from skmotion.live import DetectorStream, GestureDetector
 from skmotion.metrics import detection_f1
 from skmotion.tree import MotionTreeEncoder
-from skmotion.utils.estimator_checks import ClipCase, parametrize_with_clip_checks
 from tests.conftest import SHARED_DATA
 
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from skmotion.datasets import make_motions
+from skmotion.estimator_checks import ClipCase, parametrize_with_clip_checks
 from skmotion.live import ActivitySegmenter
 from skmotion.live._segmenter import _covering_mean, runs
-from skmotion.utils.estimator_checks import ClipCase, parametrize_with_clip_checks
 
 
 def concatenated(X, y, idx, seed):
