@@ -61,7 +61,8 @@ psi_rank = Extension(
     ["skmotion/neighbors/_psi_rank.pyx"],
     extra_compile_args=["-O3"],
 )
-# Sliding window statistics and subsequence DTW of the occurrence search (neighbors/_occurrences.py).
+# Sliding window statistics and subsequence DTW of the occurrence search
+# (neighbors/_occurrences.py).
 occurrence_loops = Extension(
     "skmotion.neighbors._occurrence_loops",
     ["skmotion/neighbors/_occurrence_loops.pyx"],

@@ -3,6 +3,7 @@
 
 from skmotion.neighbors._interval_index import IntervalIndex
 from skmotion.neighbors._interval_neighbors import IntervalIndexNeighbors
+from skmotion.neighbors._motion_matcher import MotionMatcher, floor_frames
 from skmotion.neighbors._occurrences import find_occurrences
 from skmotion.neighbors._psi import pairwise_psi, psi
 from skmotion.neighbors._sharded import ShardedIntervalIndex
@@ -10,8 +11,10 @@ from skmotion.neighbors._sharded import ShardedIntervalIndex
 __all__ = [
     "IntervalIndex",
     "IntervalIndexNeighbors",
+    "MotionMatcher",
     "ShardedIntervalIndex",
     "find_occurrences",
+    "floor_frames",
     "pairwise_psi",
     "psi",
 ]
