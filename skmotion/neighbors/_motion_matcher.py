@@ -38,7 +38,7 @@ __all__ = ["MotionMatcher", "floor_frames"]
 _ROLES = {"root": ("pelvis",), "lefts": ("left_hip", "left_shoulder")}
 _ROLES["rights"] = tuple(name.replace("left", "right") for name in _ROLES["lefts"])
 #: HNSW graph degree and construction beam (hnswlib's recommended range).
-HNSW_M, HNSW_EF_CONSTRUCTION = 16, 200
+HNSW_M, HNSW_EF_CONSTRUCTION = 16, 100
 
 
 def floor_frames(points, *, root, lefts, rights, up="y"):
@@ -117,7 +117,7 @@ class MotionMatcher(BaseEstimator):
     algorithm : {"auto", "kd_tree", "ball_tree", "brute", "hnsw"}, default="auto"
         ``"auto"`` is the exact ``"kd_tree"``; ``"hnsw"`` is approximate
         (needs the ``hnswlib`` package, the ``ann`` extra).
-    leaf_size : int, default=16
+    leaf_size : int, default=40
         Leaf size of the trees.
     ef : int, default=64
         HNSW search beam: larger is slower and more often exact.
@@ -182,7 +182,7 @@ class MotionMatcher(BaseEstimator):
         velocity_weight=1.0,
         trajectory_weight=1.0,
         algorithm="auto",
-        leaf_size=16,
+        leaf_size=40,
         ef=64,
         n_jobs=None,
         random_state=None,
@@ -336,14 +336,17 @@ class MotionMatcher(BaseEstimator):
         distance : ndarray of shape (n_queries, n_neighbors)
             Euclidean, nearest first.
         """
-        check_is_fitted(self)
+        if not hasattr(self, "features_"):
+            # check_is_fitted's scan of the attributes costs as much as an approximate query.
+            check_is_fitted(self)
         X = np.atleast_2d(np.asarray(X, dtype=float))
         if X.shape[1] != self.features_.shape[1]:
             raise ValueError(
                 f"X has {X.shape[1]} features; the index has {self.features_.shape[1]}"
             )
-        if not np.isfinite(X).all():
-            row = int(np.flatnonzero(~np.isfinite(X).all(axis=1))[0])
+        finite = np.isfinite(X).all(axis=1)
+        if not finite.all():
+            row = int(np.flatnonzero(~finite)[0])
             raise ValueError(f"query {row} holds NaN or inf")
         k = min(int(n_neighbors), len(self.features_))
         if isinstance(self.index_, (KDTree, BallTree)):
