@@ -93,7 +93,7 @@ def _contenders(matcher, matcher_kw):
     out = []
     for algorithm in ("kd_tree", "hnsw"):
         start = time.perf_counter()
-        m = MotionMatcher(**matcher_kw, algorithm=algorithm, n_jobs=2, random_state=0)
+        m = MotionMatcher(**matcher_kw, algorithm=algorithm, random_state=0)
         # The same features: only the search structure is built again.
         m.features_, m.take_, m.frame_ = matcher.features_, matcher.take_, matcher.frame_
         m._build()
@@ -139,7 +139,7 @@ def frame_search(name, matcher_kw, index_takes, query_takes, n_queries):
     matcher = MotionMatcher(**matcher_kw).fit(index_takes)
     print(f"{name}: features in {time.perf_counter() - started:.1f} s")
     rng = np.random.default_rng(0)
-    pool = np.concatenate(matcher.transform(query_takes))
+    pool = np.concatenate(matcher.frame_features(query_takes))
     queries = pool[rng.choice(len(pool), size=min(n_queries, len(pool)), replace=False)]
     timings = {}
     for label, build, prepare, func in _contenders(matcher, matcher_kw):

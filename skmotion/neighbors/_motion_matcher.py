@@ -24,6 +24,7 @@ from sklearn.base import BaseEstimator
 from sklearn.neighbors import BallTree, KDTree
 from sklearn.utils.validation import check_is_fitted
 
+from skmotion.base import VersionedStateMixin
 from skmotion.io import Motion
 from skmotion.kinematics import get_layout
 from skmotion.kinematics._layouts import layout_plan
@@ -93,7 +94,7 @@ def _trajectory(origin, yaw, offsets):
     return np.concatenate([ahead, aside, np.cos(turn), np.sin(turn)], axis=1)
 
 
-class MotionMatcher(BaseEstimator):
+class MotionMatcher(VersionedStateMixin, BaseEstimator):
     """Index every frame of long takes by its motion-matching feature; find the nearest frames.
 
     Parameters
@@ -121,10 +122,9 @@ class MotionMatcher(BaseEstimator):
         Leaf size of the trees.
     ef : int, default=64
         HNSW search beam: larger is slower and more often exact.
-    n_jobs : int, default=None
-        Threads building the HNSW graph.
     random_state : int or None, default=None
-        Seed of the HNSW graph's levels.
+        Seed of the HNSW graph's levels (built on one thread, so that a seed
+        gives one graph).
 
     Attributes
     ----------
@@ -167,7 +167,6 @@ class MotionMatcher(BaseEstimator):
         "algorithm": [StrOptions({"auto", "kd_tree", "ball_tree", "brute", "hnsw"})],
         "leaf_size": [Interval(Integral, 1, None, closed="left")],
         "ef": [Interval(Integral, 1, None, closed="left")],
-        "n_jobs": [Integral, None],
         "random_state": ["random_state"],
     }
 
@@ -184,7 +183,6 @@ class MotionMatcher(BaseEstimator):
         algorithm="auto",
         leaf_size=40,
         ef=64,
-        n_jobs=None,
         random_state=None,
     ):
         self.layout = layout
@@ -197,7 +195,6 @@ class MotionMatcher(BaseEstimator):
         self.algorithm = algorithm
         self.leaf_size = leaf_size
         self.ef = ef
-        self.n_jobs = n_jobs
         self.random_state = random_state
 
     def _take_points(self, take, i):
@@ -297,13 +294,13 @@ class MotionMatcher(BaseEstimator):
         elif algorithm == "ball_tree":
             self.index_ = BallTree(data, leaf_size=self.leaf_size)
         elif algorithm == "hnsw":
-            self.index_ = _hnsw_index(data, self.n_jobs, self.random_state)
+            self.index_ = _hnsw_index(data, self.random_state)
             self.index_.set_ef(self.ef)
         else:
             self.index_ = None
             self.squared_norms_ = np.einsum("ij,ij->i", data, data)
 
-    def transform(self, X):
+    def frame_features(self, X):
         """The weighted, normalised feature of every frame of new takes.
 
         Frames whose future runs past their take use its last frame.
@@ -326,7 +323,7 @@ class MotionMatcher(BaseEstimator):
         Parameters
         ----------
         X : array-like of shape (n_queries, n_features)
-            Features as in ``features_`` (from :meth:`transform`, or a row of
+            Features as in ``features_`` (from :meth:`frame_features`, or a row of
             ``features_`` with the trajectory replaced by a desired one).
         n_neighbors : int, default=1
 
@@ -376,7 +373,7 @@ def _brute_force(data, squared_norms, X, k):
     return distance, index
 
 
-def _hnsw_index(data, n_jobs, random_state):
+def _hnsw_index(data, random_state):
     try:
         import hnswlib
     except ImportError as exc:  # pragma: no cover - depends on the environment
@@ -388,5 +385,5 @@ def _hnsw_index(data, n_jobs, random_state):
     index.init_index(
         max_elements=len(data), ef_construction=HNSW_EF_CONSTRUCTION, M=HNSW_M, random_seed=seed
     )
-    index.add_items(data.astype(np.float32), np.arange(len(data)), num_threads=n_jobs or 1)
+    index.add_items(data.astype(np.float32), np.arange(len(data)), num_threads=1)
     return index

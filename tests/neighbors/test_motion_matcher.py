@@ -97,7 +97,7 @@ def walks():
 def test_exact_search_equals_brute_force(walks, algorithm):
     takes, new = walks
     matcher = MotionMatcher(algorithm=algorithm).fit(takes)
-    queries = np.concatenate(matcher.transform(new))[::7]
+    queries = np.concatenate(matcher.frame_features(new))[::7]
     take, frame, distance = matcher.kneighbors(queries, n_neighbors=3)
     full = np.linalg.norm(queries[:, None, :] - matcher.features_[None], axis=2)
     order = np.argsort(full, axis=1)[:, :3]
@@ -111,7 +111,7 @@ def test_hnsw_recall(walks):
     takes, new = walks
     exact = MotionMatcher().fit(takes)
     approx = clone(exact).set_params(algorithm="hnsw", random_state=0).fit(takes)
-    queries = np.concatenate(exact.transform(new))
+    queries = np.concatenate(exact.frame_features(new))
     found = approx.kneighbors(queries)[2][:, 0]
     truth = exact.kneighbors(queries)[2][:, 0]
     assert np.mean(np.isclose(found, truth, rtol=1e-5, atol=1e-5)) >= 0.99
@@ -129,7 +129,7 @@ def test_weights_scale_the_groups(walks):
 def test_pickle_and_clone(walks):
     takes, new = walks
     matcher = MotionMatcher(algorithm="ball_tree").fit(takes)
-    queries = np.concatenate(matcher.transform(new))[:20]
+    queries = np.concatenate(matcher.frame_features(new))[:20]
     again = pickle.loads(pickle.dumps(matcher))
     for a, b in zip(matcher.kneighbors(queries), again.kneighbors(queries)):
         np.testing.assert_array_equal(a, b)
