@@ -30,7 +30,7 @@ import numpy as np
 from skmotion.io import Motion
 from skmotion.planning._plan import _place
 
-__all__ = ["MatchedPath", "follow_path", "path_distance"]
+__all__ = ["MatchedPath", "follow_path", "path_distance", "path_from_velocities"]
 
 _TWO_PI = 2.0 * np.pi
 
@@ -63,6 +63,69 @@ def path_distance(points, path):
     t = np.einsum("psk,sk->ps", points[:, None, :] - a[None], ab) / np.einsum("sk,sk->s", ab, ab)
     closest = a[None] + np.clip(t, 0.0, 1.0)[..., None] * ab[None]
     return np.linalg.norm(points[:, None, :] - closest, axis=2).min(axis=1)
+
+
+def path_from_velocities(velocities, frame_rate, start=(0.0, 0.0)):
+    """The floor path a velocity command per frame traces: points for :func:`follow_path`.
+
+    Parameters
+    ----------
+    velocities : array-like of shape (n_frames, 2)
+        Floor velocity (m/s, the planner's axes) commanded at each frame.
+    frame_rate : float
+        Frames per second.
+    start : (float, float), default=(0, 0)
+
+    Returns
+    -------
+    path : ndarray of shape (n_frames + 1, 2)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.planning import path_from_velocities
+    >>> path_from_velocities(np.array([[1.0, 0.0], [1.0, 0.0], [0.0, 1.0]]), 2.0)
+    array([[0. , 0. ],
+           [0.5, 0. ],
+           [1. , 0. ],
+           [1. , 0.5]])
+    """
+    steps = np.asarray(velocities, dtype=float) / float(frame_rate)
+    if steps.ndim != 2 or steps.shape[1] != 2 or not np.isfinite(steps).all():
+        raise ValueError(f"velocities must be finite, of shape (n_frames, 2); got {steps.shape}")
+    return np.vstack([start, start + np.cumsum(steps, axis=0)])
+
+
+def _check_path(path):
+    """A float (n, 2) polyline without repeated points (consecutive repeats are dropped)."""
+    points = np.asarray(path, dtype=float)
+    if points.ndim != 2 or points.shape[1] != 2 or not np.isfinite(points).all():
+        raise ValueError(f"path must be finite floor points of shape (n, 2); got {points.shape}")
+    # A zero-length leg has no direction: keep the first of repeated points (say so below).
+    keep = np.concatenate([[True], np.hypot(*np.diff(points, axis=0).T) > 1e-9])
+    points = points[keep]
+    if len(points) < 2:
+        raise ValueError("path needs two distinct points or more")
+    return points
+
+
+def _check_takes(matcher, takes):
+    """The takes the matcher was fitted on, all on one skeleton."""
+    if not hasattr(matcher, "origin_"):
+        raise ValueError("the matcher is not fitted: fit it on the takes first")
+    if len(takes) != len(matcher.origin_):
+        raise ValueError(
+            f"{len(takes)} takes, but the matcher was fitted on {len(matcher.origin_)}"
+        )
+    skeleton = getattr(takes[0], "skeleton", None)
+    for i, take in enumerate(takes):
+        if getattr(take, "skeleton", None) is None or take.n_channels != skeleton.n_channels:
+            raise ValueError(f"take {i}: every take must be a Motion on the first take's skeleton")
+        if take.n_frames != len(matcher.origin_[i]):
+            raise ValueError(
+                f"take {i} has {take.n_frames} frames; the matcher saw {len(matcher.origin_[i])}"
+            )
+    return skeleton
 
 
 class _Path:
@@ -162,7 +225,7 @@ def _desired_trajectory(matcher, path, s, speed, root):
     return np.concatenate([ahead, aside, np.cos(turn), np.sin(turn)])
 
 
-def _search(matcher, row, trajectory, current):
+def _search(matcher, row, trajectory):
     """The best database (take, frame) for the current features with the desired trajectory."""
     query = matcher.features_[row].copy()
     cols = matcher.groups_["trajectory"]
@@ -193,7 +256,9 @@ def follow_path(
         The database.
     path : array-like of shape (n_vertices, 2)
         Floor points (metres, the planner's axes: :func:`plan_axes`); the
-        character starts at the first, facing the second.
+        character starts at the first, facing the second. A velocity command
+        per frame becomes points by :func:`path_from_velocities`. Repeated
+        consecutive points count once.
     speed : float, default=None
         Speed along the path, m/s; by default the database's median root speed.
     search_every : int, default=5
@@ -227,8 +292,10 @@ def follow_path(
     >>> bool(result.root_error.max() < 0.2), result.motion.skeleton is data.skeleton
     (True, True)
     """
-    route = _Path(path)
-    skeleton = takes[0].skeleton
+    route = _Path(_check_path(path))
+    skeleton = _check_takes(matcher, takes)
+    if search_every < 1:
+        raise ValueError(f"search_every must be 1 or more; got {search_every}")
     unit = skeleton.meters_per_unit or 1.0
     rate = matcher.frame_rate_
     dt = 1.0 / rate
@@ -245,7 +312,7 @@ def follow_path(
     row_of = {(int(t), int(f)): i for i, (t, f) in enumerate(zip(matcher.take_, matcher.frame_))}
     root = np.array([*route.points[0], route.heading[0]])
     s = 0.0
-    take, frame = _search(matcher, 0, _desired_trajectory(matcher, route, s, speed, root), None)
+    take, frame = _search(matcher, 0, _desired_trajectory(matcher, route, s, speed, root))
     offset = np.zeros(skeleton.n_channels)
     offset_v = np.zeros(skeleton.n_channels)
     # The spring's rate: the offset halves in about blend_halflife (Holden's damping / 2).
@@ -273,7 +340,7 @@ def follow_path(
         if (n + 1) % search_every == 0 or (take, frame) not in row_of:
             row = row_of.get((take, frame), row_of.get((take, frame - 1), 0))
             wanted = _desired_trajectory(matcher, route, s, speed, root)
-            new_take, new_frame = _search(matcher, row, wanted, (take, frame))
+            new_take, new_frame = _search(matcher, row, wanted)
             if new_take != take or abs(new_frame - frame) > 2:
                 old, new = canonical[take], canonical[new_take]
                 # The offset from the new frame to where the old clip would have gone.

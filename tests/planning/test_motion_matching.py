@@ -9,7 +9,7 @@ import pytest
 from skmotion.datasets import make_walks
 from skmotion.io import Motion, as_motions, read_bvh, write_bvh
 from skmotion.neighbors import MotionMatcher
-from skmotion.planning import follow_path, path_distance
+from skmotion.planning import follow_path, path_distance, path_from_velocities
 
 #: Four metres forward in four legs, 0.25 m to either side.
 ZIGZAG = np.array([[0.0, 0.0], [1.0, 0.25], [2.0, -0.25], [3.0, 0.25], [4.0, 0.0]])
@@ -73,3 +73,24 @@ def test_follows_the_zigzag_on_cmu_walks(shared_data):
     result = follow_path(matcher, takes, ZIGZAG)
     assert result.root_error.max() <= 0.2
     assert result.jump.mean() < 0.5 * result.jump_unblended.mean()
+
+
+def test_a_velocity_command_is_a_path(database):
+    takes, matcher = database
+    # 1.2 m/s forward for 1.5 s, then 1.2 m/s turning left at 0.5 rad/s for 1.5 s.
+    heading = np.concatenate([np.zeros(45), 0.5 * np.arange(45) / 30.0])
+    command = 1.2 * np.column_stack([np.cos(heading), np.sin(heading)])
+    path = path_from_velocities(command, 30.0)
+    np.testing.assert_allclose(path[45], [1.8, 0.0])
+    result = follow_path(matcher, takes, path)
+    assert result.root_error.max() <= 0.2
+
+
+def test_bad_input_is_named(database):
+    takes, matcher = database
+    with pytest.raises(ValueError, match="two distinct points"):
+        follow_path(matcher, takes, [[0.0, 0.0], [0.0, 0.0]])
+    with pytest.raises(ValueError, match="fitted on"):
+        follow_path(matcher, takes[:3], ZIGZAG)
+    with pytest.raises(ValueError, match="finite"):
+        path_from_velocities(np.array([[1.0, np.nan]]), 30.0)
