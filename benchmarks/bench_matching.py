@@ -21,7 +21,7 @@ One run, skmotion beside its peers on the same data and the same queries:
 
 Run: ``python benchmarks/bench_matching.py`` (minutes); ``--quick`` indexes
 10^5 synthetic frames and a fifth of MSRC-12. Needs the ``bench`` and ``ann``
-extras (stumpy, tslearn, faiss-cpu, hnswlib).
+extras (stumpy, tslearn, faiss-cpu).
 """
 
 import argparse
@@ -93,7 +93,7 @@ def _contenders(matcher, matcher_kw):
     out = []
     for algorithm in ("kd_tree", "hnsw"):
         start = time.perf_counter()
-        m = MotionMatcher(**matcher_kw, algorithm=algorithm, random_state=0)
+        m = MotionMatcher(**matcher_kw, algorithm=algorithm)
         # The same features: only the search structure is built again.
         m.features_, m.take_, m.frame_ = matcher.features_, matcher.take_, matcher.frame_
         m._build()
@@ -103,9 +103,8 @@ def _contenders(matcher, matcher_kw):
             out.append(("skmotion MotionMatcher kd_tree", build, None, func))
             continue
         for ef in EFS:
-            out.append(
-                (f"skmotion MotionMatcher hnsw ef={ef}", build, partial(m.index_.set_ef, ef), func)
-            )
+            prepare = partial(m.set_params, ef=ef)
+            out.append((f"skmotion MotionMatcher hnsw ef={ef}", build, prepare, func))
     for algorithm in ("brute", "kd_tree", "ball_tree"):
         start = time.perf_counter()
         nn = NearestNeighbors(n_neighbors=1, algorithm=algorithm).fit(data)

@@ -106,15 +106,22 @@ def test_exact_search_equals_brute_force(walks, algorithm):
     np.testing.assert_array_equal(frame, matcher.frame_[order])
 
 
-def test_hnsw_recall(walks):
-    pytest.importorskip("hnswlib")
+def test_hnsw_recall_and_pickle(walks):
+    pytest.importorskip("faiss")
     takes, new = walks
     exact = MotionMatcher().fit(takes)
-    approx = clone(exact).set_params(algorithm="hnsw", random_state=0).fit(takes)
+    approx = clone(exact).set_params(algorithm="hnsw").fit(takes)
     queries = np.concatenate(exact.frame_features(new))
     found = approx.kneighbors(queries)[2][:, 0]
     truth = exact.kneighbors(queries)[2][:, 0]
     assert np.mean(np.isclose(found, truth, rtol=1e-5, atol=1e-5)) >= 0.99
+    again = pickle.loads(pickle.dumps(approx))
+    for a, b in zip(approx.kneighbors(queries), again.kneighbors(queries)):
+        np.testing.assert_array_equal(a, b)
+    # Built on one thread: a second fit gives the same graph and the same answers.
+    np.testing.assert_array_equal(
+        clone(approx).fit(takes).kneighbors(queries)[1], approx.kneighbors(queries)[1]
+    )
 
 
 def test_weights_scale_the_groups(walks):
