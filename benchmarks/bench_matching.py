@@ -11,17 +11,20 @@ One run, skmotion beside its peers on the same data and the same queries:
   force; ``IndexHNSWFlat``, efSearch 64). recall@1: the share of queries whose
   first answer is at the exact nearest distance;
 - **occurrence search** (``find_occurrences``): a 2 s query cut from the data
-  (with noise) searched in the same takes, against stumpy's ``match`` and a
-  brute-force top-10 (every window z-normalised explicitly, in chunks);
+  (with noise) searched in a synthetic take (``--frames`` frames of six smooth
+  channels: random sinusoids at gait-like rates and a slow drift) and in
+  MSRC-12's sequences end to end (hands and feet in the body frame), against
+  stumpy's ``match`` and a brute-force top-10 (every window z-normalised explicitly, in chunks);
   subsequence DTW against tslearn's ``dtw_subsequence_path`` (MSRC-12 only:
   tslearn's cost matrix has a row per take frame);
 - **controller** (``follow_path``): the 4 m zig-zag on the built-in walks and
   on CMU subject 07's walks: root error, pose jumps with and without the
   blend; ``--figure`` draws docs/images/motion_matching_paths.png.
 
-Run: ``python benchmarks/bench_matching.py`` (minutes); ``--quick`` indexes
-10^5 synthetic frames and a fifth of MSRC-12. Needs the ``bench`` and ``ann``
-extras (stumpy, tslearn, faiss-cpu).
+Run: ``python benchmarks/bench_matching.py`` (minutes on an idle machine; most
+of it builds the HNSW graphs of 10^6 frames); ``--quick`` uses 10^5 synthetic
+frames and a fifth of MSRC-12; ``--parts occurrences,controller`` runs some parts.
+Needs the ``bench`` and ``ann`` extras (stumpy, tslearn, faiss-cpu).
 """
 
 import argparse
@@ -326,6 +329,19 @@ def _figure(results):
     print("wrote", folder / "motion_matching_paths.png")
 
 
+def _smooth_take(n_frames, n_channels, seed):
+    """A long synthetic take: per channel, random sinusoids at gait-like rates plus a slow drift."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n_frames) / 30.0
+    take = np.zeros((n_frames, n_channels))
+    for c in range(n_channels):
+        for _ in range(4):
+            freq, phase = rng.uniform(0.2, 2.5), rng.uniform(0, 2 * np.pi)
+            take[:, c] += rng.uniform(0.2, 1.0) * np.sin(2 * np.pi * freq * t + phase)
+        take[:, c] += np.cumsum(rng.normal(scale=0.01, size=n_frames))
+    return take
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
@@ -334,49 +350,47 @@ def main():
     parser.add_argument("--frames", type=int, default=10**6, help="synthetic frames to index")
     parser.add_argument("--queries", type=int, default=1000)
     parser.add_argument("--figure", action="store_true", help="write the controller's figure")
+    parser.add_argument(
+        "--parts",
+        default="frames,occurrences,controller",
+        help="comma-separated: frames, occurrences, controller",
+    )
     args = parser.parse_args()
+    parts = set(args.parts.split(","))
     frames = 10**5 if args.quick else args.frames
     load = os.getloadavg()
     notes = f"load average at the start: {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f}"
-    start = time.perf_counter()
-    index_takes, query_takes = _walks(frames, 0), _walks(max(frames // 50, 3000), 1)
-    print(f"walks generated in {time.perf_counter() - start:.1f} s")
-    search_rows, walk_matcher = frame_search(
-        "synthetic walks", {}, index_takes, query_takes, args.queries
-    )
-    occurrence_rows = []
-    write_results("matching_frames", search_rows, notes=notes)
-    # The synthetic take: the indexed frames' body-frame ankles, end to end (the pelvis
-    # is the body frame's origin: constant across the floor).
-    raw = walk_matcher.features_ * walk_matcher.scale_ + walk_matcher.mean_
-    walk_take = np.ascontiguousarray(raw[:, 3:9])
-    occurrences("synthetic walks", walk_take, len(walk_take) // 3, 60, occurrence_rows, False)
-    if (SHARED_DATA / "msrc12").is_dir():
-        seqs, person = _msrc(0.2 if args.quick else 1.0)
-        kw = {"layout": "kinect_v1", "frame_rate": 15.0, "points": ("left_hand", "right_hand")}
-        rows, msrc = frame_search(
-            "MSRC-12 (odd persons indexed)",
-            kw,
-            [s for s, p in zip(seqs, person) if p % 2],
-            [s for s, p in zip(seqs, person) if not p % 2],
-            args.queries,
-        )
-        search_rows += rows
-        # Marker features: hands and feet in the body frame, every sequence end to end.
-        plan = layout_plan(
-            get_layout("kinect_v1"), ["left_hand", "right_hand", "left_toe", "right_toe"]
-        )
-        roles = {k: plan[k] for k in ("root", "lefts", "rights", "outputs")}
-        take = np.concatenate(
-            [
-                position_frame_features(s.reshape(len(s), -1, 3), **roles, velocities=False)
-                for s in seqs
-            ]
-        )
-        occurrences("MSRC-12 sequences", take, len(take) // 2, 30, occurrence_rows, True)
-        write_results("matching_frames", search_rows, notes=notes)
-    write_results("matching_occurrences", occurrence_rows, notes=notes)
-    write_results("matching_controller", controller(args.figure), notes=notes)
+    have_msrc = (SHARED_DATA / "msrc12").is_dir()
+    seqs, person = _msrc(0.2 if args.quick else 1.0) if have_msrc else ([], [])
+    if "frames" in parts:
+        start = time.perf_counter()
+        index_takes, query_takes = _walks(frames, 0), _walks(max(frames // 50, 3000), 1)
+        print(f"walks generated in {time.perf_counter() - start:.1f} s")
+        rows, _ = frame_search("synthetic walks", {}, index_takes, query_takes, args.queries)
+        if have_msrc:
+            kw = {"layout": "kinect_v1", "frame_rate": 15.0, "points": ("left_hand", "right_hand")}
+            odd = [s for s, p in zip(seqs, person) if p % 2]
+            even = [s for s, p in zip(seqs, person) if not p % 2]
+            rows += frame_search("MSRC-12 (odd persons indexed)", kw, odd, even, args.queries)[0]
+        write_results("matching_frames", rows, notes=notes)
+    if "occurrences" in parts:
+        rows = []
+        occurrences("synthetic take", _smooth_take(frames, 6, 0), frames // 3, 60, rows, False)
+        if have_msrc:
+            # Marker features: hands and feet in the body frame, every sequence end to end.
+            names = ["left_hand", "right_hand", "left_toe", "right_toe"]
+            plan = layout_plan(get_layout("kinect_v1"), names)
+            roles = {k: plan[k] for k in ("root", "lefts", "rights", "outputs")}
+            take = np.concatenate(
+                [
+                    position_frame_features(s.reshape(len(s), -1, 3), **roles, velocities=False)
+                    for s in seqs
+                ]
+            )
+            occurrences("MSRC-12 sequences", take, len(take) // 2, 30, rows, True)
+        write_results("matching_occurrences", rows, notes=notes)
+    if "controller" in parts:
+        write_results("matching_controller", controller(args.figure), notes=notes)
 
 
 if __name__ == "__main__":
