@@ -253,7 +253,7 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         self._validate_params()
         takes = list(X)
         if not takes:
-            raise ValueError("no takes to index")
+            raise ValueError("no takes to index: the collection is empty")
         raw, self.frame_rate_, self.future_frames_ = self._raw_features(takes)
         horizon = int(self.future_frames_.max())
         keep = [np.arange(max(len(f) - horizon, 0)) for f, _, _ in raw]

@@ -10,6 +10,7 @@ from skmotion.datasets import make_walks
 from skmotion.io import as_motions
 from skmotion.kinematics import get_layout
 from skmotion.neighbors import MotionMatcher, floor_frames
+from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 
 KINECT = get_layout("kinect_v1")
 
@@ -154,3 +155,35 @@ def test_bad_input_is_named(walks):
     matcher = MotionMatcher().fit(takes)
     with pytest.raises(ValueError, match="query 1 holds NaN"):
         matcher.kneighbors(np.vstack([matcher.features_[:1], np.full((1, 30), np.nan)]))
+
+
+def _walk_data():
+    data = make_walks(1, random_state=0)
+    return as_motions(data.clips, data.skeleton, data.frame_rate), None
+
+
+_NOT_CLIPS = "the takes are Motions with a skeleton, not channel arrays"
+
+
+@parametrize_with_clip_checks(
+    [
+        ClipCase(
+            MotionMatcher(),
+            _walk_data,
+            skip={
+                "check_containers_agree": _NOT_CLIPS,
+                "check_fitted_attributes": "no n_features_in_: " + _NOT_CLIPS,
+                "check_channel_mismatch": _NOT_CLIPS,
+                "check_nan_rejected": _NOT_CLIPS,
+                "check_too_short": _NOT_CLIPS,
+                "check_input_not_modified": _NOT_CLIPS,
+                "check_set_output_pandas": "not a transformer",
+                "check_cross_val_score": "no score: a search structure",
+                "check_grid_search": "no score: a search structure",
+                "check_n_jobs": "no n_jobs",
+            },
+        )
+    ]
+)
+def test_clip_conformance(check):
+    check()
