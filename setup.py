@@ -1,5 +1,6 @@
 """The compiled parts of skmotion: the motion database's decoders, the online stream,
-the body frame of point trajectories, and the similarity search's eigenpairs and psi.
+the body frame of point trajectories, the similarity search's eigenpairs and psi, and the
+occurrence search's sliding statistics and subsequence DTW.
 
 Everything else is in pyproject.toml.
 """
@@ -65,4 +66,11 @@ psi_rank = Extension(
     ["skmotion/neighbors/_psi_rank.pyx"],
     extra_compile_args=["-O3"],
 )
-setup(ext_modules=cythonize([*beam, *online, position_frame, leading, psi_rank]))
+# Sliding window statistics and subsequence DTW of the occurrence search
+# (neighbors/_occurrences.py).
+occurrence_loops = Extension(
+    "skmotion.neighbors._occurrence_loops",
+    ["skmotion/neighbors/_occurrence_loops.pyx"],
+    extra_compile_args=["-O3"],
+)
+setup(ext_modules=cythonize([*beam, *online, position_frame, leading, psi_rank, occurrence_loops]))

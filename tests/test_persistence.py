@@ -13,10 +13,11 @@ from sklearn.base import BaseEstimator
 import skmotion
 from skmotion.base import IncompatibleVersionError, VersionedStateMixin, compatible_versions
 from skmotion.control import KMeansPrimitiveController
-from skmotion.datasets import humanoid_skeleton, make_motions
+from skmotion.datasets import humanoid_skeleton, make_motions, make_walks
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
+from skmotion.io import as_motions
 from skmotion.live import ActivitySegmenter, GestureDetector
-from skmotion.neighbors import IntervalIndexNeighbors
+from skmotion.neighbors import IntervalIndexNeighbors, MotionMatcher
 from skmotion.preprocessing import (
     FillGaps,
     FlattenClips,
@@ -44,6 +45,11 @@ def _joint_angles():
         n_clips_per_class=2, classes=["walk", "squat"], duration=(0.6, 1.0), random_state=0
     )
     return data.clips, data.target
+
+
+def _walk_takes():
+    data = make_walks(1, turn=1.0, random_state=0)
+    return as_motions(data.clips, data.skeleton, data.frame_rate), None
 
 
 def _strokes():
@@ -88,6 +94,14 @@ CASES = {
         {
             "kneighbors": lambda est, X: list(est.kneighbors(X)),
             "candidates": lambda est, X: [np.concatenate(est.candidates(X))],
+        },
+    ),
+    "MotionMatcher": (
+        MotionMatcher(),
+        _walk_takes,
+        {
+            "kneighbors": lambda est, X: list(est.kneighbors(est.features_[::9], n_neighbors=2)),
+            "frame_features": _extra("frame_features"),
         },
     ),
     "SVDFeatureExtractor": (

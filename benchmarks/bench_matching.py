@@ -1,0 +1,397 @@
+"""Search inside long takes: frame search (MotionMatcher), occurrence search, the controller.
+
+One run, skmotion beside its peers on the same data and the same queries:
+
+- **frame search** (``MotionMatcher``): synthetic long takes (walks in four
+  directions, turning, ``make_walks``; ``--frames`` frames indexed, 10^6 by
+  default) and MSRC-12's Kinect sequences (350k frames). Queries are frames of
+  held-out takes (other seeds; MSRC-12: the odd persons are indexed, the even
+  persons queried), one per call. Peers: sklearn ``NearestNeighbors``
+  (brute, kd_tree, ball_tree) and faiss (``IndexFlatL2``: compiled brute
+  force; ``IndexHNSWFlat``, efSearch 64). recall@1: the share of queries whose
+  first answer is at the exact nearest distance;
+- **occurrence search** (``find_occurrences``): a 2 s query cut from the data
+  (with noise) searched in a synthetic take (``--frames`` frames of six smooth
+  channels: random sinusoids at gait-like rates and a slow drift) and in
+  MSRC-12's sequences end to end (hands and feet in the body frame), against
+  stumpy's ``match`` and a brute-force top-10 (every window z-normalised explicitly, in chunks);
+  subsequence DTW against tslearn's ``dtw_subsequence_path`` (MSRC-12 only:
+  tslearn's cost matrix has a row per take frame);
+- **controller** (``follow_path``): the 4 m zig-zag on the built-in walks and
+  on CMU subject 07's walks: root error, pose jumps with and without the
+  blend; ``--figure`` draws docs/images/motion_matching_paths.png.
+
+Run: ``python benchmarks/bench_matching.py`` (minutes on an idle machine; most
+of it builds the HNSW graphs of 10^6 frames); ``--quick`` uses 10^5 synthetic
+frames and a fifth of MSRC-12; ``--parts occurrences,controller`` runs some parts.
+Needs the ``bench`` and ``ann`` extras (stumpy, tslearn, faiss-cpu).
+"""
+
+import argparse
+import dataclasses
+import os
+import sys
+import time
+from collections import Counter
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import SHARED_DATA, write_results  # noqa: E402
+
+from skmotion.datasets import make_walks  # noqa: E402
+from skmotion.io import Motion, as_motions, read_bvh  # noqa: E402
+from skmotion.kinematics import get_layout  # noqa: E402
+from skmotion.kinematics._layouts import layout_plan  # noqa: E402
+from skmotion.neighbors import MotionMatcher, find_occurrences  # noqa: E402
+from skmotion.neighbors._motion_matcher import HNSW_EF_CONSTRUCTION, HNSW_M  # noqa: E402
+from skmotion.planning import follow_path  # noqa: E402
+from skmotion.preprocessing._position_frame import position_frame_features  # noqa: E402
+
+EFS = tuple(sorted({32, 64, 128, MotionMatcher().ef}))
+HNSW_DEFAULT = f"skmotion MotionMatcher hnsw ef={MotionMatcher().ef}"
+ZIGZAG = np.array([[0.0, 0.0], [1.0, 0.25], [2.0, -0.25], [3.0, 0.25], [4.0, 0.0]])
+
+
+def _walks(n_frames, seed):
+    """Long turning walks in four directions, about ``n_frames`` frames in all."""
+    per_direction = max(1, int(round(n_frames / 4 / 900)))
+    data = make_walks(per_direction, turn=1.0, duration=(25.0, 35.0), random_state=seed)
+    return as_motions(data.clips, data.skeleton, data.frame_rate)
+
+
+def _msrc(fraction):
+    """MSRC-12 sequences as (positions per sequence, person per sequence)."""
+    data = np.load(SHARED_DATA / "msrc12" / "msrc12_sequences.npz")
+    offsets, person = data["offsets"], data["person"]
+    n = int(round((len(offsets) - 1) * fraction))
+    seqs = [data["positions"][offsets[i] : offsets[i + 1]].astype(float) for i in range(n)]
+    # A few sequences are empty (every frame untracked): they hold nothing to search.
+    keep = [i for i in range(n) if len(seqs[i]) >= 2]
+    return [seqs[i] for i in keep], person[:n][keep]
+
+
+def _time_single(func, queries):
+    """Wall and CPU microseconds per call of ``func(one_query)``, over all queries; answers.
+
+    The CPU time is the process's: on a loaded machine it is closer to what a query
+    costs alone than the wall time, which includes waiting for a core.
+    """
+    out = []
+    wall, cpu = time.perf_counter(), time.process_time()
+    for q in queries:
+        out.append(func(q[None]))
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    return wall / len(queries) * 1e6, cpu / len(queries) * 1e6, np.asarray(out)
+
+
+def _contenders(matcher, matcher_kw):
+    """(label, build seconds, prepare, query function) of skmotion and every peer."""
+    import faiss
+    from sklearn.neighbors import NearestNeighbors
+
+    data = matcher.features_
+    out = []
+    for algorithm in ("kd_tree", "hnsw"):
+        start = time.perf_counter()
+        m = MotionMatcher(**matcher_kw, algorithm=algorithm)
+        # The same features: only the search structure is built again.
+        m.features_, m.take_, m.frame_ = matcher.features_, matcher.take_, matcher.frame_
+        m._build()
+        build = time.perf_counter() - start
+        func = lambda q, m=m: m.kneighbors(q)[2][0, 0]  # noqa: E731
+        if algorithm == "kd_tree":
+            out.append(("skmotion MotionMatcher kd_tree", build, None, func))
+            continue
+        for ef in EFS:
+            prepare = partial(m.set_params, ef=ef)
+            out.append((f"skmotion MotionMatcher hnsw ef={ef}", build, prepare, func))
+    for algorithm in ("brute", "kd_tree", "ball_tree"):
+        start = time.perf_counter()
+        nn = NearestNeighbors(n_neighbors=1, algorithm=algorithm).fit(data)
+        func = lambda q, nn=nn: nn.kneighbors(q)[0][0, 0]  # noqa: E731
+        out.append(
+            (f"sklearn NearestNeighbors {algorithm}", time.perf_counter() - start, None, func)
+        )
+    data32 = np.ascontiguousarray(data, dtype=np.float32)
+    faiss.omp_set_num_threads(2)
+    flat = faiss.IndexFlatL2(data.shape[1])
+    hnsw = faiss.IndexHNSWFlat(data.shape[1], HNSW_M)
+    hnsw.hnsw.efConstruction = HNSW_EF_CONSTRUCTION
+    for index in (flat, hnsw):
+        start = time.perf_counter()
+        index.add(data32)
+        build = time.perf_counter() - start
+        func = lambda q, index=index: float(np.sqrt(index.search(q.astype(np.float32), 1)[0][0, 0]))  # noqa: E731
+        if index is flat:
+            out.append(("faiss IndexFlatL2", build, None, func))
+            continue
+        for ef in EFS:
+            prepare = partial(setattr, index.hnsw, "efSearch", ef)
+            out.append((f"faiss IndexHNSWFlat efSearch={ef}", build, prepare, func))
+    faiss.omp_set_num_threads(1)  # single queries on one thread, as the others
+    return out
+
+
+def frame_search(name, matcher_kw, index_takes, query_takes, n_queries):
+    """One table's rows: skmotion's exact and approximate search beside the peers."""
+    started = time.perf_counter()
+    matcher = MotionMatcher(**matcher_kw).fit(index_takes)
+    print(f"{name}: features in {time.perf_counter() - started:.1f} s")
+    rng = np.random.default_rng(0)
+    pool = np.concatenate(matcher.frame_features(query_takes))
+    queries = pool[rng.choice(len(pool), size=min(n_queries, len(pool)), replace=False)]
+    timings = {}
+    for label, build, prepare, func in _contenders(matcher, matcher_kw):
+        if prepare is not None:
+            prepare()
+        # The brute-force scans are slow: a tenth of the queries is enough to time them.
+        slow = "brute" in label or "Flat" in label and "HNSW" not in label
+        subset = queries[: max(20, len(queries) // 10)] if slow else queries
+        timings[label] = (build, *_time_single(func, subset))
+        print(f"  {label}: {timings[label][1]:.1f} us per query")
+    # sklearn's k-d tree is exact: its answers are the truth (brute force agrees on its subset).
+    exact = timings["sklearn NearestNeighbors kd_tree"][3]
+    ours = {k: timings[k][1] for k in ("skmotion MotionMatcher kd_tree", HNSW_DEFAULT)}
+    rows = []
+    for label, (build, wall, cpu, answers) in timings.items():
+        count = len(answers)
+        recall = np.mean(np.abs(answers - exact[:count]) <= 1e-4 * (1 + exact[:count]))
+        rows.append(
+            {
+                "data": name,
+                "n_frames": len(matcher.features_),
+                "n_features": matcher.features_.shape[1],
+                "method": label,
+                "build_s": round(build, 2),
+                "us_per_query": round(wall, 1),
+                "cpu_us_per_query": round(cpu, 1),
+                "recall@1": round(float(recall), 4),
+                "queries": count,
+                "ratio_to_kd_tree": round(wall / ours["skmotion MotionMatcher kd_tree"], 2),
+                "ratio_to_hnsw": round(wall / ours[HNSW_DEFAULT], 2),
+            }
+        )
+    return rows, matcher
+
+
+def _brute_top(query, take, k, exclusion):
+    """Top-k z-normalised windows by explicit z-normalisation, greedy exclusion (chunks)."""
+    m = len(query)
+    q = (query - query.mean(0)) / query.std(0)
+    profile = np.empty(len(take) - m + 1)
+    for start in range(0, len(profile), 20000):
+        stop = min(start + 20000, len(profile))
+        w = np.lib.stride_tricks.sliding_window_view(take[start : stop + m - 1], m, axis=0)
+        w = w.transpose(0, 2, 1)  # (windows, m, channels)
+        z = (w - w.mean(axis=1, keepdims=True)) / w.std(axis=1, keepdims=True)
+        profile[start:stop] = np.sqrt(((z - q) ** 2).sum(axis=1)).mean(axis=1)
+    found = []
+    while len(found) < k:
+        i = int(np.argmin(profile))
+        found.append(i)
+        profile[max(0, i - exclusion) : i + exclusion + 1] = np.inf
+    return found
+
+
+def occurrences(name, take, query_at, m, rows, dtw_peer):
+    import stumpy
+
+    rng = np.random.default_rng(1)
+    query = take[query_at : query_at + m] + rng.normal(scale=0.01, size=(m, take.shape[1]))
+    stumpy.match(query.T.copy(), take[:5000].T.copy(), max_distance=np.inf, max_matches=2)
+    start = time.perf_counter()
+    found = find_occurrences(query, [take], n_occurrences=10)
+    ours = time.perf_counter() - start
+    start = time.perf_counter()
+    peer = stumpy.match(query.T.copy(), take.T.copy(), max_distance=np.inf, max_matches=10)
+    theirs = time.perf_counter() - start
+    brute = _brute_top(query, take, 10, int(np.ceil(m / 4)))
+    same_brute = found["start"].tolist() == brute
+    same_stumpy = found["start"].tolist() == peer[:, 1].astype(int).tolist()
+    rows.append(
+        {
+            "data": name,
+            "take_frames": len(take),
+            "channels": take.shape[1],
+            "query_frames": m,
+            "method": "znorm top-10",
+            "skmotion_s": round(ours, 3),
+            "peer": "stumpy.match",
+            "peer_s": round(theirs, 3),
+            "speedup": round(theirs / ours, 1),
+            "top10_equal_brute_force": same_brute,
+            "top10_equal_peer": same_stumpy,
+        }
+    )
+    start = time.perf_counter()
+    found = find_occurrences(query, [take], metric="dtw", n_occurrences=1)
+    ours = time.perf_counter() - start
+    row = {
+        "data": name,
+        "take_frames": len(take),
+        "channels": take.shape[1],
+        "query_frames": m,
+        "method": "subsequence DTW top-1",
+        "skmotion_s": round(ours, 3),
+        "peer": "",
+        "peer_s": "",
+        "speedup": "",
+        "top10_equal_brute_force": "",
+        "top10_equal_peer": "",
+    }
+    if dtw_peer:
+        from tslearn.metrics import dtw_subsequence_path
+
+        dtw_subsequence_path(query[:5], take[:50])
+        start = time.perf_counter()
+        path, distance = dtw_subsequence_path(query, take)
+        theirs = time.perf_counter() - start
+        same = (found["start"][0], found["end"][0]) == (path[0][1], path[-1][1] + 1)
+        row.update(
+            peer="tslearn dtw_subsequence_path",
+            peer_s=round(theirs, 3),
+            speedup=round(theirs / ours, 1),
+            top10_equal_peer=bool(same and np.isclose(found["distance"][0], distance)),
+            top10_equal_brute_force="(tests)",
+        )
+    rows.append(row)
+
+
+def _cmu_walks():
+    files = sorted((SHARED_DATA / "cmu-bvh" / "07").glob("*.bvh"))
+    motions = [read_bvh(f) for f in files]
+    common = Counter(m.n_channels for m in motions).most_common(1)[0][0]
+    motions = [m for m in motions if m.n_channels == common]
+    skeleton = dataclasses.replace(motions[0].skeleton, meters_per_unit=0.01, units="cm")
+    return [Motion(skeleton, m.channels, frame_rate=m.frame_rate) for m in motions]
+
+
+def controller(figure):
+    data = make_walks(8, turn=1.5, random_state=0)
+    sets = {
+        "make_walks": as_motions(data.clips, data.skeleton, data.frame_rate),
+        "CMU 07 walks": _cmu_walks(),
+    }
+    rows, results = [], {}
+    for name, takes in sets.items():
+        matcher = MotionMatcher().fit(takes)
+        for label, kw in (("adjusted", {}), ("no adjustment", {"adjust_halflife": None})):
+            start = time.perf_counter()
+            result = follow_path(matcher, takes, ZIGZAG, **kw)
+            seconds = time.perf_counter() - start
+            results[name, label] = result
+            rows.append(
+                {
+                    "database": name,
+                    "frames": len(matcher.features_),
+                    "root": label,
+                    "root_error_max_m": round(float(result.root_error.max()), 3),
+                    "root_error_mean_m": round(float(result.root_error.mean()), 3),
+                    "end_error_m": round(float(np.hypot(*(result.root[-1, :2] - ZIGZAG[-1]))), 3),
+                    "switches": len(result.switches),
+                    "jump_blended_mm": round(1000 * float(result.jump.mean()), 2),
+                    "jump_no_blend_mm": round(1000 * float(result.jump_unblended.mean()), 2),
+                    "median_step_mm": round(1000 * result.step, 2),
+                    "adjustment_share": round(result.adjustment, 3),
+                    "synthesis_s": round(seconds, 2),
+                }
+            )
+    if figure:
+        _figure(results)
+    return rows
+
+
+def _figure(results):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(2, 1, figsize=(8.0, 5.0), sharex=True)
+    for ax, name in zip(axes, ("make_walks", "CMU 07 walks")):
+        ax.plot(*ZIGZAG.T, "k--", lw=1.5, label="desired path")
+        for label, colour in (("adjusted", "C0"), ("no adjustment", "C1")):
+            r = results[name, label]
+            ax.plot(r.root[:, 0], r.root[:, 1], color=colour, lw=1.5, label=f"root, {label}")
+            ax.plot(*r.root[r.switches, :2].T, "o", color=colour, ms=3)
+        ax.set_title(f"{name}: root path (dots: database switches)")
+        ax.set_ylabel("left (m)")
+        ax.set_aspect("equal")
+        ax.set_ylim(-0.45, 0.65)
+        ax.legend(fontsize=7, loc="upper center", ncol=3, frameon=False)
+    axes[-1].set_xlabel("forward (m)")
+    fig.tight_layout()
+    folder = Path(__file__).resolve().parents[1] / "docs" / "images"
+    fig.savefig(folder / "motion_matching_paths.png", dpi=110)
+    print("wrote", folder / "motion_matching_paths.png")
+
+
+def _smooth_take(n_frames, n_channels, seed):
+    """A long synthetic take: per channel, random sinusoids at gait-like rates plus a slow drift."""
+    rng = np.random.default_rng(seed)
+    t = np.arange(n_frames) / 30.0
+    take = np.zeros((n_frames, n_channels))
+    for c in range(n_channels):
+        for _ in range(4):
+            freq, phase = rng.uniform(0.2, 2.5), rng.uniform(0, 2 * np.pi)
+            take[:, c] += rng.uniform(0.2, 1.0) * np.sin(2 * np.pi * freq * t + phase)
+        take[:, c] += np.cumsum(rng.normal(scale=0.01, size=n_frames))
+    return take
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--quick", action="store_true", help="10^5 synthetic frames, 1/5 of MSRC-12"
+    )
+    parser.add_argument("--frames", type=int, default=10**6, help="synthetic frames to index")
+    parser.add_argument("--queries", type=int, default=1000)
+    parser.add_argument("--figure", action="store_true", help="write the controller's figure")
+    parser.add_argument(
+        "--parts",
+        default="frames,occurrences,controller",
+        help="comma-separated: frames, occurrences, controller",
+    )
+    args = parser.parse_args()
+    parts = set(args.parts.split(","))
+    frames = 10**5 if args.quick else args.frames
+    load = os.getloadavg()
+    notes = f"load average at the start: {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f}"
+    have_msrc = (SHARED_DATA / "msrc12").is_dir()
+    seqs, person = _msrc(0.2 if args.quick else 1.0) if have_msrc else ([], [])
+    if "frames" in parts:
+        start = time.perf_counter()
+        index_takes, query_takes = _walks(frames, 0), _walks(max(frames // 50, 3000), 1)
+        print(f"walks generated in {time.perf_counter() - start:.1f} s")
+        rows, _ = frame_search("synthetic walks", {}, index_takes, query_takes, args.queries)
+        if have_msrc:
+            kw = {"layout": "kinect_v1", "frame_rate": 15.0, "points": ("left_hand", "right_hand")}
+            odd = [s for s, p in zip(seqs, person) if p % 2]
+            even = [s for s, p in zip(seqs, person) if not p % 2]
+            rows += frame_search("MSRC-12 (odd persons indexed)", kw, odd, even, args.queries)[0]
+        write_results("matching_frames", rows, notes=notes)
+    if "occurrences" in parts:
+        rows = []
+        occurrences("synthetic take", _smooth_take(frames, 6, 0), frames // 3, 60, rows, False)
+        if have_msrc:
+            # Marker features: hands and feet in the body frame, every sequence end to end.
+            names = ["left_hand", "right_hand", "left_toe", "right_toe"]
+            plan = layout_plan(get_layout("kinect_v1"), names)
+            roles = {k: plan[k] for k in ("root", "lefts", "rights", "outputs")}
+            take = np.concatenate(
+                [
+                    position_frame_features(s.reshape(len(s), -1, 3), **roles, velocities=False)
+                    for s in seqs
+                ]
+            )
+            occurrences("MSRC-12 sequences", take, len(take) // 2, 30, rows, True)
+        write_results("matching_occurrences", rows, notes=notes)
+    if "controller" in parts:
+        write_results("matching_controller", controller(args.figure), notes=notes)
+
+
+if __name__ == "__main__":
+    main()
