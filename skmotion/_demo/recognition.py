@@ -1,12 +1,11 @@
 """Demo section: recognising motions, estimating the state and predicting it with MotionTreeHMM."""
 
 import numpy as np
-from sklearn.linear_model import LogisticRegression
-from sklearn.pipeline import make_pipeline
 
 from skmotion._demo._figures import save_figure
 from skmotion._demo._split import confusion_lines, evaluation_of
-from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
+from skmotion.recognition import MotionClassifier
+from skmotion.tree import MotionTreeHMM
 from skmotion.utils import say
 
 TITLE = "Recognition: the motion database (MotionTreeHMM)"
@@ -35,8 +34,8 @@ def _trust_text(proba, right):
 
 
 def _beside_the_decoder(model, X_train, y_train, X_test, y_test):
-    """The tree as a vocabulary (MotionTreeEncoder) into a linear model; probabilities; novelty."""
-    encoder = make_pipeline(MotionTreeEncoder(), LogisticRegression(max_iter=5000))
+    """MotionClassifier (the tree as a vocabulary into a linear model); probabilities; novelty."""
+    encoder = MotionClassifier()  # the clips are markers already: channels scaled one by one
     encoder.fit(X_train, y_train)
     proba = model.predict_proba(X_test)
     right = model.classes_[proba.argmax(axis=1)] == y_test
@@ -52,14 +51,15 @@ def _beside_the_decoder(model, X_train, y_train, X_test, y_test):
         return 100.0 * np.searchsorted(reference, scores, side="right") / len(reference)
 
     return [
-        f"MotionTreeEncoder + LogisticRegression (the recommended recogniser) on the same split: "
+        f"MotionClassifier (the recommended recogniser: the tree's vocabulary into a logistic "
+        f"regression) on the same split: "
         f"accuracy {encoder.score(X_test, y_test):.3f}",
         f"class probabilities: MotionTreeHMM turns its class scores into probabilities by a "
         f"softmax whose temperature ({model.temperature_:.3g}) is fitted by log loss on held-out "
         f"folds of the training clips; its top probability averages "
         f"{_top_probability_text(proba, right)}"
         + _trust_text(proba, right)
-        + "; the encoder's logistic regression gives "
+        + "; MotionClassifier's logistic regression gives "
         + _top_probability_text(encoder_proba, encoder_right),
         f"novelty (mean log density per frame under the tree's nodes), as a percentile of the "
         f"{len(reference)} training clips' scores (0: stranger than all of them): test clips "
