@@ -400,7 +400,8 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
 
     def __setstate__(self, state):
         super().__setstate__(state)
-        if type(self._stored) is GrowableStore:  # pickled before StoredClips
+        # a fitted index pickled before StoredClips (an unfitted one has no store)
+        if type(getattr(self, "_stored", None)) is GrowableStore:
             self._stored = StoredClips.adopt(self._stored)
 
     # -- input -------------------------------------------------------------------
