@@ -56,8 +56,9 @@ def _as_list(result):
             starts = np.flatnonzero(np.r_[True, codes[1:] != codes[:-1]])
             return np.split(result.to_numpy(), starts[1:])
         return [result.to_numpy()]
-    if isinstance(result, (list, tuple)):
-        return [np.asarray(r) for r in result]
+    if isinstance(result, (list, tuple)):  # per-clip arrays, or a tuple such as decode's
+        parts = [_as_list(r) if isinstance(r, list) else [np.asarray(r)] for r in result]
+        return [a for part in parts for a in part]
     if isinstance(result, np.ndarray) and result.dtype != object and result.ndim == 3:
         return list(result)
     return [np.asarray(result)]
