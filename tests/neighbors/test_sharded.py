@@ -56,7 +56,9 @@ def test_sharded_answers_equal_the_single_index(client, motions, params, n_shard
     sharded = ShardedIntervalIndex(
         IntervalIndexNeighbors(random_state=0, **params), client=client, n_shards=n_shards
     ).fit(stored, labels)
-    np.testing.assert_array_equal(sharded.layout_.radius_, single.radius_)
+    # the widths are reduced over shards in another order: equal up to rounding (~1e-17); the
+    # candidates and neighbours below must still be exactly the single index's
+    np.testing.assert_allclose(sharded.layout_.radius_, single.radius_, rtol=1e-12, atol=1e-15)
     for got, expected in zip(sharded.candidates(queries), single.candidates(queries)):
         np.testing.assert_array_equal(got, expected)
     for k in (1, 4, len(stored)):  # len(stored): every query falls back to all clips
