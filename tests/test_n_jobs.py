@@ -13,10 +13,11 @@ import numpy as np
 import pytest
 from sklearn.base import clone
 
-from skmotion.datasets import humanoid_skeleton, make_motions
+from skmotion.datasets import humanoid_skeleton, make_motions, make_position_motions
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor, _clip_svd
 from skmotion.neighbors import IntervalIndexNeighbors, _interval_neighbors, _psi, pairwise_psi
 from skmotion.preprocessing import FillGaps, LowPassFilter, VirtualMarkerTransform
+from skmotion.recognition import MotionClassifier
 from skmotion.tree import MotionTreeHMM
 from skmotion.tree._decoder import _batch
 from skmotion.utils import _parallel
@@ -56,6 +57,11 @@ def _joint_angles():
     data = make_motions(
         n_clips_per_class=2, classes=["walk", "squat", "wave"], duration=(0.6, 1.0), random_state=0
     )
+    return data.clips, data.target
+
+
+def _positions():
+    data = make_position_motions("kinect_v2", n_clips_per_class=2, random_state=0)
     return data.clips, data.target
 
 
@@ -101,6 +107,11 @@ CASES = {
         None,
     ),
     "LowPassFilter": (LowPassFilter(order=4), _motions, None),
+    "MotionClassifier": (
+        MotionClassifier(layout="kinect_v2", frame_rate=30.0, max_depth=3),
+        _positions,
+        lambda est, X: {"novelty": [est.novelty_score(X)]},
+    ),
     "FillGaps": (FillGaps(layout="kinect_v1"), _holed_positions, None),
 }
 

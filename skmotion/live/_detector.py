@@ -144,11 +144,13 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
     ...     take[end - 19 : end + 1] += np.linspace(0, 1, 20)[:, None]
     >>> detector = GestureDetector(window=10, random_state=0)
     >>> detector = detector.fit([take], ["rise"], action_points=[points])
+    >>> # trigger="fall": an event when the score drops after its run above the threshold,
+    >>> # a few frames after each completion (the last one, at the take's end, never drops)
     >>> [(event.frame, event.label) for event in detector.detect([take])[0]]
-    [(45, 'rise'), (115, 'rise'), (185, 'rise'), (257, 'rise'), (325, 'rise'), (397, 'rise')]
+    [(53, 'rise'), (123, 'rise'), (193, 'rise'), (263, 'rise'), (333, 'rise')]
     >>> stream = detector.stream()                       # the same, one frame at a time
     >>> [event.frame for frame in take for event in stream.update(frame)]
-    [45, 115, 185, 257, 325, 397]
+    [53, 123, 193, 263, 333]
     """
 
     _parameter_constraints = {
