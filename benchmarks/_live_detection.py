@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 from _common import SHARED_DATA
+from _msrc12 import msrc12_takes
 from sklearn.base import BaseEstimator, ClassifierMixin, clone
 from sklearn.linear_model import LogisticRegression, RidgeClassifierCV
 from sklearn.model_selection import GroupKFold
@@ -35,24 +36,16 @@ GESTURES = (
 
 
 def msrc12():
-    """Takes (float positions), action points, gestures, person ids; empty takes left out.
-
-    The stored takes lost their untracked (all-zero) frames: the few action points
-    before a take's first frame or past its last are left out."""
-    data = np.load(SHARED_DATA / "msrc12" / "msrc12_sequences.npz")
-    positions, offsets = data["positions"], data["offsets"]
-    points, point_offsets = data["action_points"], data["action_point_offsets"]
-    takes, aps, gestures, people = [], [], [], []
-    for i in range(len(offsets) - 1):
-        take = positions[offsets[i] : offsets[i + 1]].astype(float)
-        if len(take) < 2:
-            continue
-        takes.append(take)
-        found = points[point_offsets[i] : point_offsets[i + 1]].astype(np.intp)
-        aps.append(found[(found >= 0) & (found < len(take))])  # a few fall in removed frames
-        gestures.append(GESTURES[int(data["gesture"][i]) - 1])
-        people.append(int(data["person"][i]))
-    return takes, aps, np.array(gestures, dtype=object), np.array(people)
+    """Takes (float positions), action points, gestures, person ids; empty takes left out
+    (the takes and their action points as :func:`_msrc12.msrc12_takes` reads them)."""
+    takes, points, gesture, person = msrc12_takes(SHARED_DATA / "msrc12" / "msrc12_sequences.npz")
+    keep = [i for i, take in enumerate(takes) if len(take) >= 2]
+    return (
+        [takes[i] for i in keep],
+        [points[i] for i in keep],
+        np.array([GESTURES[int(gesture[i]) - 1] for i in keep], dtype=object),
+        np.array([int(person[i]) for i in keep]),
+    )
 
 
 class MiniRocketWindows(ClassifierMixin, BaseEstimator):

@@ -30,6 +30,29 @@ GESTURES = (
 MIN_FRAMES = 4  # a repetition shorter than this is an annotation slip
 
 
+def msrc12_takes(path):
+    """Every sequence as a take ``(n_frames, 60)``, float64, with its action points inside it.
+
+    The stored takes lost their untracked (all-zero) frames, so a few action points
+    fall before a take's first frame or past its last: they are left out.
+
+    Returns
+    -------
+    takes, action_points : list of ndarray
+    gesture, person : ndarray of int, one per take (gesture 1-12, person 1-30)
+    """
+    d = np.load(path)
+    positions, offsets = d["positions"], d["offsets"]
+    points, point_offsets = d["action_points"], d["action_point_offsets"]
+    takes, inside = [], []
+    for i in range(len(offsets) - 1):
+        take = positions[offsets[i] : offsets[i + 1]].astype(np.float64)
+        found = points[point_offsets[i] : point_offsets[i + 1]].astype(np.intp)
+        takes.append(take)
+        inside.append(found[(found >= 0) & (found < len(take))])
+    return takes, inside, np.asarray(d["gesture"]), np.asarray(d["person"])
+
+
 def msrc12_repetitions(path, *, gestures=None, max_per_sequence=None):
     """The repetitions of every sequence as clips ``(n_frames, 60)``, float64, metres.
 
@@ -49,21 +72,18 @@ def msrc12_repetitions(path, *, gestures=None, max_per_sequence=None):
         sequence), one per clip; ``frame_rate``; ``names`` (gesture names).
         Action points before the first tracked frame (negative) start no clip.
     """
-    d = np.load(path)
-    positions, offsets = d["positions"].astype(np.float64), d["offsets"]
-    points, point_offsets = d["action_points"], d["action_point_offsets"]
+    takes, action_points, take_gesture, take_person = msrc12_takes(path)
     clips, gesture, person, sequence = [], [], [], []
-    for i in range(len(offsets) - 1):
-        if gestures is not None and d["gesture"][i] not in gestures:
+    for i, (frames, ends) in enumerate(zip(takes, action_points)):
+        if gestures is not None and take_gesture[i] not in gestures:
             continue
-        frames = positions[offsets[i] : offsets[i + 1]]
         start, kept = 0, 0
-        for end in points[point_offsets[i] : point_offsets[i + 1]]:
-            if 0 <= end < len(frames) and end + 1 - start >= MIN_FRAMES:
+        for end in ends:
+            if end + 1 - start >= MIN_FRAMES:
                 if max_per_sequence is None or kept < max_per_sequence:
                     clips.append(frames[start : end + 1])
-                    gesture.append(d["gesture"][i])
-                    person.append(d["person"][i])
+                    gesture.append(take_gesture[i])
+                    person.append(take_person[i])
                     sequence.append(i)
                     kept += 1
             start = max(start, end + 1)
