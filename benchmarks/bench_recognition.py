@@ -227,7 +227,7 @@ class PerClassHMM:
 
 
 def peer_frames(Xtr):
-    lengths = [len(x) for x in Xtr]
+    lengths = [x.n_frames if hasattr(x, "n_frames") else len(x) for x in Xtr]  # Motions too
     return int(min(PEER_FRAMES, max(9, statistics.median(lengths))))  # MiniRocket needs 9
 
 
