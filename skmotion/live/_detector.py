@@ -23,6 +23,12 @@ from skmotion.utils._sklearn_compat import HasMethods, Interval, StrOptions, _fi
 __all__ = ["GestureDetector"]
 
 
+def _labels_per_point(y, action_points):
+    """Per take, the label of each action point: ``y`` gives one per take or one per point."""
+    sizes = [len(points) for points in action_points]
+    return labels_per_take(y, sizes, "take {i} has {got} labels for its {n} action points.")
+
+
 def _check_points(action_points, clips):
     if action_points is None:  # clips that each end as their motion completes
         return [np.array([len(take) - 1], dtype=np.intp) for take in clips]
@@ -206,9 +212,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         if len(y) != len(clips):
             raise ValueError(f"y: {len(y)} labels for {len(clips)} takes.")
         points = _check_points(action_points, clips)
-        labels = labels_per_take(
-            y, [len(p) for p in points], "take {i} has {got} labels for its {n} action points."
-        )
+        labels = _labels_per_point(y, points)
         if any(self.none_label in set(names) for names in labels):
             raise ValueError(f"y: the rejection class {self.none_label!r} labels an action point.")
         rng = np.random.default_rng(check_random_state(self.random_state).randint(2**31))
