@@ -29,7 +29,7 @@ import scipy.sparse as sp
 from sklearn.base import BaseEstimator, TransformerMixin
 
 from skmotion.tree import MotionTreeEncoder
-from skmotion.tree._histograms import _signed_power_unit_norm
+from skmotion.tree._encoding._histograms import _signed_power_unit_norm
 from skmotion.utils._clips import stack_clips
 
 

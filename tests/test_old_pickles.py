@@ -85,3 +85,27 @@ def test_old_online_state_loads_from_its_old_path():
     assert state.frame == 3 and len(state.nodes) == 3
     again = pickle.loads(pickle.dumps(state))  # and pickles again under its new path
     _assert_same_answers(dict(again), dict(state))
+
+
+ENCODER_FIXTURE = Path(__file__).parent / "data" / "encoder_before_encoding.pkl"
+
+
+def test_old_encoder_loads_from_its_old_routing_module():
+    """``data/encoder_before_encoding.pkl`` (23 KB) was written by skmotion 0.1.0 before
+    ``tree/_encoding`` existed: its ``TreeRouter`` names ``skmotion.tree._routing``.
+    It holds a fitted ``MotionTreeEncoder`` and its transform, written by::
+
+        data = make_motions(n_clips_per_class=2, classes=["walk", "jump"],
+                            duration=(1.0, 1.0), random_state=0)
+        X = [c[::2, 6:20] for c in data.clips]
+        encoder = MotionTreeEncoder(max_depth=3).fit(X)
+        (pickled with X), then the answer: encoder.transform(X) (dense)
+    """
+    if not compatible_versions(SAVED_BY, skmotion.__version__):
+        pytest.skip(f"skmotion {skmotion.__version__} refuses pickles of {SAVED_BY}, as designed")
+    saved = pickle.loads(ENCODER_FIXTURE.read_bytes())
+    encoder, X = saved["objects"]["encoder"], saved["X"]
+    assert type(encoder._router).__module__ == "skmotion.tree._encoding._routing"
+    got = encoder.transform(X)
+    got = got.toarray() if hasattr(got, "toarray") else got
+    np.testing.assert_array_equal(got, saved["answers"]["transform"])

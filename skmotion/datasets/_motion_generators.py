@@ -11,6 +11,21 @@ from scipy.interpolate import CubicSpline
 _TWO_PI = 2.0 * np.pi
 
 
+def _check_names(what, names, allowed):
+    """Refuse ``names`` unless they are distinct, at least one, and all in ``allowed``."""
+    unknown = [n for n in names if n not in allowed]
+    if unknown or not names or len(set(names)) != len(names):
+        raise ValueError(f"{what} must be distinct names from {list(allowed)}; got {list(names)}.")
+
+
+def _check_duration(duration):
+    """Refuse a ``duration`` that is not ``(min, max)`` seconds with ``0 < min <= max``."""
+    if len(duration) != 2 or not 0 < duration[0] <= duration[1]:
+        raise ValueError(
+            f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}."
+        )
+
+
 class _Pose:
     """Joint angles (degrees) of one clip, filled by anatomical names.
 

@@ -5,6 +5,7 @@ from numbers import Integral, Real
 import numpy as np
 from sklearn.utils import Bunch, check_random_state
 
+from skmotion.datasets._motion_generators import _check_duration
 from skmotion.datasets._synthetic import make_motions
 from skmotion.kinematics import forward_kinematics
 from skmotion.utils._sklearn_compat import Interval, StrOptions, validate_params
@@ -110,10 +111,7 @@ def make_repeated_motions(
     >>> data.class_names[data.motion_class[:6]].tolist()
     ['walk', 'walk', 'walk', 'walk', 'walk', 'walk']
     """
-    if len(duration) != 2 or not 0 < duration[0] <= duration[1]:
-        raise ValueError(
-            f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}."
-        )
+    _check_duration(duration)
     rng = check_random_state(random_state)
     total = n_repeats * float(duration[1])
     source = make_motions(

@@ -6,7 +6,14 @@ import numpy as np
 from sklearn.utils import Bunch, check_random_state
 
 from skmotion.datasets._humanoid import humanoid_skeleton
-from skmotion.datasets._motion_generators import _GENERATORS, _TWO_PI, _other, _Pose
+from skmotion.datasets._motion_generators import (
+    _GENERATORS,
+    _TWO_PI,
+    _check_duration,
+    _check_names,
+    _other,
+    _Pose,
+)
 from skmotion.kinematics import forward_kinematics
 from skmotion.utils._sklearn_compat import Interval, validate_params
 
@@ -189,15 +196,8 @@ def make_motions(
     [0, 1, 2, 3]
     """
     names = MOTION_CLASSES if classes is None else tuple(classes)
-    unknown = [c for c in names if c not in MOTION_CLASSES]
-    if unknown or not names or len(set(names)) != len(names):
-        raise ValueError(
-            f"classes must be distinct names from {list(MOTION_CLASSES)}; got {list(names)}."
-        )
-    if len(duration) != 2 or not 0 < duration[0] <= duration[1]:
-        raise ValueError(
-            f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}."
-        )
+    _check_names("classes", names, MOTION_CLASSES)
+    _check_duration(duration)
     rng = check_random_state(random_state)
     subjects = [_subject_style(rng) for _ in range(n_subjects)]
     reference = humanoid_skeleton()

@@ -6,7 +6,15 @@ import numpy as np
 from sklearn.utils import Bunch, check_random_state
 
 from skmotion.datasets._humanoid import humanoid_skeleton
-from skmotion.datasets._motion_generators import _TWO_PI, _WALK, _bump, _gait, _Pose
+from skmotion.datasets._motion_generators import (
+    _TWO_PI,
+    _WALK,
+    _bump,
+    _check_duration,
+    _check_names,
+    _gait,
+    _Pose,
+)
 from skmotion.kinematics import forward_kinematics
 from skmotion.utils._sklearn_compat import Interval, validate_params
 
@@ -159,15 +167,8 @@ def make_walks(
     (True, True)
     """
     names = tuple(WALK_DIRECTIONS) if directions is None else tuple(directions)
-    unknown = [d for d in names if d not in WALK_DIRECTIONS]
-    if unknown or not names or len(set(names)) != len(names):
-        raise ValueError(
-            f"directions must be distinct names from {list(WALK_DIRECTIONS)}; got {list(names)}."
-        )
-    if len(duration) != 2 or not 0 < duration[0] <= duration[1]:
-        raise ValueError(
-            f"duration must be (min, max) seconds with 0 < min <= max; got {duration!r}."
-        )
+    _check_names("directions", names, WALK_DIRECTIONS)
+    _check_duration(duration)
     rng = check_random_state(random_state)
     clips, target, velocity, skeletons = [], [], [], []
     for label, direction in enumerate(names):

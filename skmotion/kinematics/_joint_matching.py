@@ -198,12 +198,17 @@ def _up_chain(tree, start, words, side, how, role, roles):
     return None
 
 
+def _limb(tree, side, roles, how, end, middle):
+    """A limb's end joint (found by name) and the joint above it: ``(None, None)`` without one."""
+    joint = _limb_end(tree, side, _LIMBS[end])
+    if joint is None:
+        return None, None
+    roles[f"{side}_{end}"], how[f"{side}_{end}"] = joint, "name"
+    return joint, _up_chain(tree, joint, _LIMBS[middle], side, how, f"{side}_{middle}", roles)
+
+
 def _arm(tree, side, roles, how):
-    wrist = _limb_end(tree, side, _LIMBS["wrist"])
-    if wrist is None:
-        return
-    roles[f"{side}_wrist"], how[f"{side}_wrist"] = wrist, "name"
-    elbow = _up_chain(tree, wrist, _LIMBS["elbow"], side, how, f"{side}_elbow", roles)
+    wrist, elbow = _limb(tree, side, roles, how, "wrist", "elbow")
     if elbow is None:
         return
     shoulder = _up_chain(tree, elbow, _LIMBS["shoulder"], side, how, f"{side}_shoulder", roles)
@@ -223,11 +228,9 @@ def _arm(tree, side, roles, how):
 
 
 def _leg(tree, side, roles, how):
-    ankle = _limb_end(tree, side, _LIMBS["ankle"])
+    ankle, knee = _limb(tree, side, roles, how, "ankle", "knee")
     if ankle is None:
         return
-    roles[f"{side}_ankle"], how[f"{side}_ankle"] = ankle, "name"
-    knee = _up_chain(tree, ankle, _LIMBS["knee"], side, how, f"{side}_knee", roles)
     if knee is not None:
         _up_chain(tree, knee, _LIMBS["hip"], side, how, f"{side}_hip", roles)
     toes = [j for j in _descendants(tree, ankle) if tree.is_(j, _LIMBS["toe"])]

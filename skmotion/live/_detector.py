@@ -11,7 +11,12 @@ from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.live._events import TRIGGERS, TriggerState, next_events
 from skmotion.live._recognizers import class_proba, default_recognizer, recognizer_classes
 from skmotion.live._stream import DetectorStream
-from skmotion.live._windows import evaluation_ends, take_windows, training_windows
+from skmotion.live._windows import (
+    evaluation_ends,
+    labels_per_take,
+    take_windows,
+    training_windows,
+)
 from skmotion.utils._clips import check_clips
 from skmotion.utils._sklearn_compat import HasMethods, Interval, StrOptions, _fit_context
 
@@ -20,18 +25,8 @@ __all__ = ["GestureDetector"]
 
 def _labels_per_point(y, action_points):
     """Per take, the label of each action point: ``y`` gives one per take or one per point."""
-    labels = []
-    for i, (label, points) in enumerate(zip(y, action_points)):
-        if np.ndim(label) == 0:
-            labels.append(np.full(len(points), label, dtype=object))
-            continue
-        label = np.asarray(label, dtype=object)
-        if label.shape != points.shape:
-            raise ValueError(
-                f"y: take {i} has {len(label)} labels for its {len(points)} action points."
-            )
-        labels.append(label)
-    return labels
+    sizes = [len(points) for points in action_points]
+    return labels_per_take(y, sizes, "take {i} has {got} labels for its {n} action points.")
 
 
 def _check_points(action_points, clips):

@@ -8,25 +8,11 @@ from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.live._recognizers import class_proba, default_recognizer, recognizer_classes
-from skmotion.live._windows import evaluation_ends, take_windows
+from skmotion.live._windows import evaluation_ends, labels_per_take, take_windows
 from skmotion.utils._clips import check_clips
 from skmotion.utils._sklearn_compat import HasMethods, Interval, _fit_context
 
 __all__ = ["ActivitySegmenter"]
-
-
-def _frame_labels(y, clips):
-    """Per take, one label per frame: ``y`` gives one per take or an array per take."""
-    labels = []
-    for i, (label, take) in enumerate(zip(y, clips)):
-        if np.ndim(label) == 0:
-            labels.append(np.full(len(take), label, dtype=object))
-            continue
-        label = np.asarray(label, dtype=object)
-        if label.shape != (len(take),):
-            raise ValueError(f"y: take {i} has {len(label)} frame labels for {len(take)} frames.")
-        labels.append(label)
-    return labels
 
 
 def _covering_mean(proba, ends, n_frames, window):
@@ -154,7 +140,9 @@ class ActivitySegmenter(ClipEstimatorMixin, BaseEstimator):
         if len(y) != len(clips):
             raise ValueError(f"y: {len(y)} labels for {len(clips)} takes.")
         windows, targets = [], []
-        for take, labels in zip(clips, _frame_labels(y, clips)):
+        sizes = [len(take) for take in clips]
+        frame_labels = labels_per_take(y, sizes, "take {i} has {got} frame labels for {n} frames.")
+        for take, labels in zip(clips, frame_labels):
             if len(take) < self.window:
                 windows.append(take)
                 targets.append(labels[len(take) // 2])

@@ -8,7 +8,7 @@ detector has seen when frame ``t`` arrives.
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-__all__ = ["evaluation_ends", "take_windows", "training_windows"]
+__all__ = ["evaluation_ends", "labels_per_take", "take_windows", "training_windows"]
 
 
 def evaluation_ends(n_frames, window, step):
@@ -21,6 +21,25 @@ def evaluation_ends(n_frames, window, step):
     if n_frames < window:
         return np.zeros(0, dtype=np.intp)
     return np.arange(window - 1, n_frames, step, dtype=np.intp)
+
+
+def labels_per_take(y, sizes, mismatch):
+    """Per take, one label per item (frame or action point) from ``y``.
+
+    ``y`` gives each take one label, or an array of one label per item; ``sizes``
+    are the items of each take; ``mismatch`` is the error's text after ``"y: "``,
+    formatted with the take ``i``, the labels it ``got`` and its ``n`` items.
+    """
+    labels = []
+    for i, (label, n) in enumerate(zip(y, sizes)):
+        if np.ndim(label) == 0:
+            labels.append(np.full(n, label, dtype=object))
+            continue
+        label = np.asarray(label, dtype=object)
+        if label.shape != (n,):
+            raise ValueError("y: " + mismatch.format(i=i, got=len(label), n=n))
+        labels.append(label)
+    return labels
 
 
 def take_windows(take, ends, window):

@@ -55,20 +55,14 @@ def plot_pruning_recall(rows, *, n_levels=7):
             if not mine:
                 continue
             eps = [r["epsilon"] for r in mine]
-            ax.plot(
-                eps,
-                [r["pruning"] for r in mine],
-                "o" + style,
-                color="C0",
-                label=f"pruning ({features})",
-            )
-            ax.plot(
-                eps,
-                [r["recall"] for r in mine],
-                "s" + style,
-                color="C1",
-                label=f"recall ({features})",
-            )
+            for measure, marker, color in (("pruning", "o", "C0"), ("recall", "s", "C1")):
+                ax.plot(
+                    eps,
+                    [r[measure] for r in mine],
+                    marker + style,
+                    color=color,
+                    label=f"{measure} ({features})",
+                )
         ax.set_title(f"{name}, {n_levels} levels")
         ax.set_xlabel("entry interval factor epsilon")
         ax.set_ylim(0, 1.02)

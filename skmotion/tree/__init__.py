@@ -2,7 +2,7 @@
 
 import sys
 
-from skmotion.tree import _growth, _online
+from skmotion.tree import _encoding, _growth, _online
 from skmotion.tree._build import PAPER_SETTINGS
 from skmotion.tree._decoder import (
     NODE_PRIORS,
@@ -17,10 +17,13 @@ from skmotion.tree._hmm import MotionTreeHMM
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._transitions import TransitionGraphs
 
-# Pickles made before the _growth and _online sub-packages name these modules:
-# they load from their new homes.
+# Pickles made before the _growth, _online and _encoding sub-packages name these
+# modules: they load from their new homes.
 sys.modules.update(
     {
+        "skmotion.tree._encoder_columns": _encoding._columns,
+        "skmotion.tree._histograms": _encoding._histograms,
+        "skmotion.tree._routing": _encoding._routing,
         "skmotion.tree._incremental": _growth._live,
         "skmotion.tree._moments": _growth._moments,
         "skmotion.tree._online_stream": _online._causal,

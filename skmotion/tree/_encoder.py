@@ -9,14 +9,14 @@ from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
 from skmotion.tree._build import TREE_CONSTRAINTS
-from skmotion.tree._encoder_columns import (
+from skmotion.tree._encoding._columns import (
     _existing,
     _int_list,
     _is_all,
     build_depth,
     feature_names,
 )
-from skmotion.tree._histograms import (
+from skmotion.tree._encoding._histograms import (
     feature_blocks,
     histogram_features,
     moment_features,
@@ -24,8 +24,8 @@ from skmotion.tree._histograms import (
     residual_features,
     second_order_features,
 )
+from skmotion.tree._encoding._routing import TreeRouter
 from skmotion.tree._motion_tree import MotionTree
-from skmotion.tree._routing import TreeRouter
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._features import channel_names_in
 from skmotion.utils._progress import say
@@ -154,7 +154,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     Notes
     -----
     Routing is one pass over the layers for all frames of all clips together
-    (:class:`~skmotion.tree._routing.TreeRouter`, the standardisation folded
+    (:class:`~skmotion.tree._encoding.TreeRouter`, the standardisation folded
     into the splits), and the histograms are one sparse matrix whose duplicate
     entries sum: no Python step per clip or frame. The defaults come from a
     study over several data sets (user guide, ``docs/motion-database.md``).

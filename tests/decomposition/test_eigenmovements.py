@@ -1,3 +1,4 @@
+import inspect
 import pickle
 
 import numpy as np
@@ -6,7 +7,7 @@ from sklearn.decomposition import PCA
 
 from skmotion.datasets import make_motions
 from skmotion.decomposition import EigenMovementPCA
-from skmotion.preprocessing import energy_segments, lowpass_filter, resample_clip
+from skmotion.preprocessing import energy_segments, lowpass_filter, resample_clip, segment_clip
 from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 from tests.preprocessing.test_segment import minimum_jerk
 
@@ -234,3 +235,15 @@ def test_clips_without_segments_give_empty_codes():
     assert np.isnan(rebuilt[0]).all()
     with pytest.raises(ValueError, match="No segments were found in the 1 clips"):
         pca.score([still])
+
+
+def test_segmentation_defaults_are_segment_clips():
+    """EigenMovementPCA repeats segment_clip's parameters in its signature (sklearn wants
+    them spelled out): their defaults must stay the same."""
+    mine = inspect.signature(EigenMovementPCA).parameters
+    theirs = inspect.signature(segment_clip).parameters
+    assert mine["segmentation"].default == theirs["rule"].default
+    shared = [name for name in theirs if name not in ("clip", "rule")]
+    assert len(shared) == 8
+    for name in shared:
+        assert mine[name].default == theirs[name].default, name

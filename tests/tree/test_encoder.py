@@ -14,7 +14,7 @@ from sklearn.pipeline import make_pipeline
 
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTree, MotionTreeEncoder
-from skmotion.tree._routing import TreeRouter
+from skmotion.tree._encoding import TreeRouter
 from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 
 

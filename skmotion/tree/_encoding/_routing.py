@@ -33,7 +33,7 @@ class TreeRouter:
     --------
     >>> import numpy as np
     >>> from skmotion.tree import MotionTree
-    >>> from skmotion.tree._routing import TreeRouter
+    >>> from skmotion.tree._encoding import TreeRouter
     >>> rng = np.random.default_rng(0)
     >>> frames = rng.normal(size=(500, 4))
     >>> tree = MotionTree.build(frames, max_depth=4, split="median")
