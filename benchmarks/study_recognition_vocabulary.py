@@ -21,14 +21,17 @@ Usage::
 
     python benchmarks/study_recognition_vocabulary.py [--only NAME ...]
 
-Writes ``results/recognition_vocabulary.{csv,md}``. Needs ``../shared/data/msrc12``.
+Writes ``results/recognition_vocabulary.{csv,md}`` and, with matplotlib, the figure
+``docs/images/recognition_vocabulary.png``. Needs ``../shared/data/msrc12``.
 """
 
 import argparse
+import csv
 import time
+from pathlib import Path
 
 import numpy as np
-from _common import SHARED_DATA, write_results
+from _common import RESULTS, SHARED_DATA, write_results
 from _msrc12 import msrc12_repetitions
 from scipy.interpolate import interp1d
 from sklearn.linear_model import LogisticRegression
@@ -212,10 +215,44 @@ def score(run, data):
     return round(float(cv), 4), round(test, 4), round(time.perf_counter() - start, 1)
 
 
+def draw(rows, path):
+    """CV and test accuracy of each variant, the baseline's CV as a line."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    names = [row["variant"] for row in rows][::-1]
+    cv = np.array([row["cv (odd people)"] for row in rows][::-1])
+    test = np.array([row["test (even people)"] for row in rows][::-1])
+    y = np.arange(len(names))
+    fig, ax = plt.subplots(figsize=(9, 0.42 * len(names) + 1.8))
+    ax.barh(y + 0.2, cv, height=0.4, label="grouped CV, training people (choices by this)")
+    ax.barh(y - 0.2, test, height=0.4, label="test people (reported only)", alpha=0.6)
+    baseline = next(row for row in rows if "baseline" in row["variant"])
+    ax.axvline(baseline["cv (odd people)"], color="k", lw=0.8, ls="--", label="baseline's CV")
+    ax.set_yticks(y, names, fontsize=8)
+    ax.set_xlim(min(cv.min(), test.min()) - 0.01, max(cv.max(), test.max()) + 0.005)
+    ax.set_xlabel("accuracy on MSRC-12 repetitions")
+    ax.set_title("MSRC-12: one change each to MotionClassifier's chain", fontsize=10)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.09), ncol=2, fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", nargs="*", help="variants whose name contains one of these")
+    parser.add_argument("--redraw", action="store_true", help="the figure from the last results")
     args = parser.parse_args()
+    if args.redraw:
+        with open(RESULTS / "recognition_vocabulary.csv") as fh:
+            rows = [
+                {k: (v if k == "variant" else float(v)) for k, v in r.items()}
+                for r in csv.DictReader(fh)
+            ]
+        return draw_figure(rows)
     data = Markers()
     runs = variants(data)
     runs["MiniRocket (aeon), reference"] = lambda a, y, b: minirocket(a, y, b, data)
@@ -233,6 +270,17 @@ def main():
         notes="MSRC-12 repetitions. cv: 3-fold grouped CV over the odd people (choices are made "
         "by it); test: odd -> even people (reported only).",
     )
+    draw_figure(rows)
+
+
+def draw_figure(rows):
+    figure = Path(__file__).resolve().parents[1] / "docs" / "images" / "recognition_vocabulary.png"
+    try:
+        draw(rows, figure)
+    except ImportError:
+        print("matplotlib is not installed: no figure")
+        return
+    print(f"figure: {figure}")
 
 
 if __name__ == "__main__":
