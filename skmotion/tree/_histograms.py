@@ -9,6 +9,8 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
+from skmotion.utils._group_sums import group_sums
+
 __all__ = [
     "feature_blocks",
     "histogram_features",
@@ -182,9 +184,6 @@ def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
     """
     lengths = np.diff(offsets)
     clip = np.repeat(np.arange(len(lengths)), lengths)
-    average = sp.csr_matrix(
-        (1.0 / lengths[clip], (clip, np.arange(len(frames)))), shape=(len(lengths), len(frames))
-    )
     # one centred copy, squared in place, the scale applied to the sums: a pass over a batch's
     # frames costs as much as the sums themselves
     centred = np.subtract(frames, center)
@@ -193,7 +192,8 @@ def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
     ]
     if order >= 2:
         np.square(centred, out=centred)
-        blocks.append(np.sqrt(average @ centred) / scale - 1.0)
+        mean_squares = group_sums(centred, clip, 1.0 / lengths[clip], len(lengths))
+        blocks.append(np.sqrt(mean_squares) / scale - 1.0)
     return np.hstack(blocks)
 
 
@@ -214,10 +214,7 @@ def _cell_means(centred, clip, lengths, parts):
         cell = (np.arange(len(clip)) - starts[clip]) * parts // lengths[clip]
     key = clip * parts + cell
     size = np.bincount(key, minlength=n_clips * parts)
-    average = sp.csr_matrix(
-        (1.0 / size[key], (key, np.arange(len(clip)))), shape=(n_clips * parts, len(clip))
-    )
-    means = average @ centred
+    means = group_sums(centred, key, 1.0 / size[key], n_clips * parts)
     empty = np.flatnonzero(size == 0)
     if len(empty):
         owner, c = np.divmod(empty, parts)
@@ -228,17 +225,18 @@ def _cell_means(centred, clip, lengths, parts):
 def _node_averages(values, nodes, offsets, k):
     """Per clip and node: the sums of ``values`` over the clip's frames in the node / its frames.
 
-    ``values`` is a list of arrays of shape (n_frames, n_channels), summed by one
-    sparse (clip, node) x frame matrix; also returns each group's share of its clip's frames.
+    ``values`` is a list of arrays of shape (n_frames, n_channels), each summed per
+    (clip, node) group in frame order (the compiled ``group_sums``: the doubles of the
+    sparse (clip, node) x frame product, without building the matrix, whose making
+    dominated a call on one clip); also returns each group's share of its clip's frames.
     """
-    n_clips, n_frames = len(offsets) - 1, len(nodes)
+    n_clips = len(offsets) - 1
     lengths = np.diff(offsets)
     clip = np.repeat(np.arange(n_clips), lengths)
     weight = 1.0 / lengths[clip]
     group = clip * k + nodes
-    average = sp.csr_matrix((weight, (group, np.arange(n_frames))), shape=(n_clips * k, n_frames))
     share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
-    return [average @ v for v in values], share
+    return [group_sums(v, group, weight, n_clips * k) for v in values], share
 
 
 def node_variances(z, nodes, means):
