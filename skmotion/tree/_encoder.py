@@ -316,7 +316,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         X_new : ndarray or scipy.sparse.csr_matrix of shape (n_clips, n_features_out_)
             Or a DataFrame after ``set_output(transform="pandas")`` (dense output only).
         """
-        check_is_fitted(self)
+        check_is_fitted(self, "tree_")
         clips = check_clips(X, estimator=self)
         sparse = self._sparse()
         if sparse and self._output_config() == "pandas":
@@ -325,11 +325,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                 f"{self.n_features_out_} columns as a sparse matrix: set sparse_output=False."
             )
         frames, offsets = stack_clips(clips)
-        routed = np.union1d(
-            np.union1d(self.layers_, self.transition_layers_), self.residual_layers_
-        )
+        layer_sets = (self.layers_, self.transition_layers_, self.residual_layers_)
+        routed = np.array(sorted({int(v) for layers in layer_sets for v in layers}), np.intp)
         # moments alone need no routing
         nodes = self._router.route(frames, routed) if len(routed) else None
+        residual_nodes = None
+        if len(self.residual_layers_):
+            residual_nodes = nodes[:, np.searchsorted(routed, self.residual_layers_)]
         parts = []
         if self._blocks:
             parts.append(histogram_features(nodes, offsets, routed, self._blocks, self.power))
@@ -337,7 +339,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             parts.append(
                 residual_features(
                     frames,
-                    nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                    residual_nodes,
                     offsets,
                     self._residual_means,
                     self.center_,
@@ -349,7 +351,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             parts.append(
                 second_order_features(
                     frames,
-                    nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                    residual_nodes,
                     offsets,
                     self._residual_means,
                     self._residual_variances,
@@ -372,7 +374,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         if sparse:
             return sp.hstack(parts, format="csr") if len(parts) > 1 else sp.csr_matrix(parts[0])
         dense = [p.toarray() if sp.issparse(p) else p for p in parts]
-        return self._wrap_table(dense[0] if len(dense) == 1 else np.hstack(dense), clips)
+        table = dense[0] if len(dense) == 1 else np.concatenate(dense, axis=1)
+        return self._wrap_table(table, clips)
 
     def _sparse(self):
         if self.sparse_output == "auto":

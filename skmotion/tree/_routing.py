@@ -92,6 +92,8 @@ class TreeRouter:
         """
         frames = np.asarray(frames, dtype=np.float64)
         layers = np.arange(self.n_layers) if layers is None else np.asarray(layers, np.intp)
+        if len(frames) <= _CHUNK:
+            return self._route_block(frames, layers)
         out = np.empty((len(frames), len(layers)), dtype=np.intp)
         for start in range(0, len(frames), _CHUNK):
             block = slice(start, start + _CHUNK)

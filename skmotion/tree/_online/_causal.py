@@ -183,7 +183,7 @@ class OnlineMotionStream:
         self.reset()
 
     def _build(self):
-        """The model's tables as the kernel reads them, made once per stream."""
+        """The model's tables as the kernel reads them (made once per fitted model, shared)."""
         model, tree = self.model, self._tree
         self._gauss = gaussian_arrays(tree)  # the batch decoder's layout: one for both kernels
         self._layers, self._norms = [], {}
