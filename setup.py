@@ -81,8 +81,24 @@ group_sums = Extension(
     ["skmotion/utils/_group_sums.pyx"],
     extra_compile_args=["-O3", "-ffp-contract=off"],
 )
+# A node's rows reordered in place along the permutation's cycles (tree/_build/_permute):
+# the build keeps no second copy of the frames.
+permute = Extension(
+    "skmotion.tree._build._permute",
+    ["skmotion/tree/_build/_permute.pyx"],
+    extra_compile_args=["-O3"],
+)
 setup(
     ext_modules=cythonize(
-        [*beam, *online, position_frame, leading, psi_rank, occurrence_loops, group_sums]
+        [
+            *beam,
+            *online,
+            position_frame,
+            leading,
+            psi_rank,
+            occurrence_loops,
+            group_sums,
+            permute,
+        ]
     )
 )

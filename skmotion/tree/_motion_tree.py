@@ -172,19 +172,32 @@ class MotionTree(VersionedStateMixin):
         return cls.from_params(frames, params)
 
     @classmethod
-    def from_params(cls, frames, params):
-        """Build the tree over frames with the parameters of a ``TreeParams``."""
+    def from_params(cls, frames, params, *, copy=True):
+        """Build the tree over frames with the parameters of a ``TreeParams``.
+
+        ``copy=False`` (for a caller's own C-contiguous float64 array, such as a
+        fit's stacked frames): the build works in ``frames`` itself, reordering
+        them and putting them back in their order at the end, so it holds no
+        second copy of the frames (the same tree).
+        """
         X = np.asarray(frames, dtype=np.float64)
         if X.ndim != 2 or len(X) == 0 or X.shape[1] == 0:
             raise ValueError(
                 f"frames must be a non-empty 2-D array (n_frames, n_channels); got shape {X.shape}."
             )
-        if not np.isfinite(X).all():
-            frame, channel = np.argwhere(~np.isfinite(X))[0]
-            raise ValueError(
-                f"frames must be finite; frame {frame}, channel {channel} is {X[frame, channel]}."
-            )
-        nodes = build_nodes(np.ascontiguousarray(X), **params.as_dict())
+        for start in range(0, len(X), _ROUTE_CHUNK):  # in blocks: no mask the size of X
+            block = X[start : start + _ROUTE_CHUNK]
+            if not np.isfinite(block).all():
+                frame, channel = np.argwhere(~np.isfinite(block))[0]
+                raise ValueError(
+                    f"frames must be finite; frame {start + frame}, channel {channel} is "
+                    f"{block[frame, channel]}."
+                )
+        X = np.ascontiguousarray(X)
+        # a conversion made a new array: the build may work in it, there is no other copy
+        owned = not isinstance(frames, np.ndarray) or not np.may_share_memory(X, frames)
+        in_place = (owned or not copy) and X.flags.writeable
+        nodes = build_nodes(X, **params.as_dict(), copy=not in_place)
         return cls(**nodes, covariance_type=params.covariance_type)
 
     # -- sizes and layer structure ------------------------------------------------
