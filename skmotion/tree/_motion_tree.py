@@ -125,6 +125,7 @@ class MotionTree(VersionedStateMixin):
         split=PAPER_TREE.split,
         covariance_type=PAPER_TREE.covariance_type,
         reg_covar=PAPER_TREE.reg_covar,
+        copy=True,
     ):
         """Build the tree over frames.
 
@@ -156,6 +157,12 @@ class MotionTree(VersionedStateMixin):
         reg_covar : float, default=1e-6
             Added to every variance, as a fraction of the mean per-channel
             variance of all frames (absolute when the frames do not vary).
+        copy : bool, default=True
+            False: when ``frames`` is a writable C-contiguous float64 array, the
+            build works in it, reordering its rows and putting them back in their
+            order at the end, so it holds no second copy of the frames (the same
+            tree; about 1.1 times the frames' memory at most instead of 2.1).
+            Do not read ``frames`` from another thread during the build.
 
         Returns
         -------
@@ -169,7 +176,7 @@ class MotionTree(VersionedStateMixin):
             covariance_type=covariance_type,
             reg_covar=reg_covar,
         )
-        return cls.from_params(frames, params)
+        return cls.from_params(frames, params, copy=copy)
 
     @classmethod
     def from_params(cls, frames, params, *, copy=True):
