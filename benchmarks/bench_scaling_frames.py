@@ -20,7 +20,9 @@ sklearn fits out above N frames (they take minutes there). ``--before SRC`` adds
 build of the skmotion source tree SRC (for example an older checkout) on the same
 frames. The two copying builds stop at 10^6 frames (their memory figure is clear
 there). The growth exponent of each method is the slope of log seconds against log
-frames over the sizes it ran. Results: ``results/scaling_frames.{csv,md}``.
+frames over the sizes it ran. ``--methods`` runs some of them (``tree_in_place``,
+``tree``, ``encoder``, ``bisecting``, ``minibatch``). Results:
+``results/<--name, default scaling_frames>.{csv,md}``.
 Run: ``python benchmarks/bench_scaling_frames.py``.
 """
 
@@ -130,8 +132,8 @@ def run(method, n, source=None):
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
-def main(sizes, peers_up_to, before=None):
-    methods = dict(METHODS)
+def main(sizes, peers_up_to, before=None, only=None, name="scaling_frames"):
+    methods = {k: v for k, v in METHODS.items() if only is None or v in only}
     if before is not None:
         methods[f"MotionTree.build, {Path(before).name}"] = "before"
     rows = []
@@ -167,7 +169,7 @@ def main(sizes, peers_up_to, before=None):
     for row in rows:
         row["s / tree s"] = row["fit s"] / tree[row["frames"]] if row["frames"] in tree else ""
     write_results(
-        "scaling_frames",
+        name,
         rows,
         notes=(
             "Each fit in a fresh process; peak RSS is that process's VmHWM from just before "
@@ -186,9 +188,11 @@ if __name__ == "__main__":
     parser.add_argument("--sizes", type=int, nargs="+")
     parser.add_argument("--peers-up-to", type=int, default=10_000_000)
     parser.add_argument("--before", type=Path, help="another skmotion source tree to compare")
+    parser.add_argument("--methods", nargs="+", choices=list(METHODS.values()))
+    parser.add_argument("--name", default="scaling_frames", help="results file name")
     args = parser.parse_args()
     if args.worker:
         worker(args.worker[0], int(args.worker[1]))
     else:
         default = [10_000, 100_000] if args.quick else [100_000, 1_000_000, 3_000_000, 10_000_000]
-        main(args.sizes or default, args.peers_up_to, args.before)
+        main(args.sizes or default, args.peers_up_to, args.before, args.methods, args.name)
