@@ -73,4 +73,32 @@ occurrence_loops = Extension(
     ["skmotion/neighbors/_occurrence_loops.pyx"],
     extra_compile_args=["-O3"],
 )
-setup(ext_modules=cythonize([*beam, *online, position_frame, leading, psi_rank, occurrence_loops]))
+# Weighted sums of rows per group, in row order (utils/_group_sums, the tree encoder's
+# per-clip sums); no contraction, so each product is rounded before it is added, as SciPy's
+# sparse product rounds it (the same doubles).
+group_sums = Extension(
+    "skmotion.utils._group_sums",
+    ["skmotion/utils/_group_sums.pyx"],
+    extra_compile_args=["-O3", "-ffp-contract=off"],
+)
+# A node's rows reordered in place along the permutation's cycles (tree/_build/_permute):
+# the build keeps no second copy of the frames.
+permute = Extension(
+    "skmotion.tree._build._permute",
+    ["skmotion/tree/_build/_permute.pyx"],
+    extra_compile_args=["-O3"],
+)
+setup(
+    ext_modules=cythonize(
+        [
+            *beam,
+            *online,
+            position_frame,
+            leading,
+            psi_rank,
+            occurrence_loops,
+            group_sums,
+            permute,
+        ]
+    )
+)

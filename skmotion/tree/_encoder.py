@@ -8,7 +8,8 @@ from sklearn.base import BaseEstimator
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
-from skmotion.tree._build import TREE_CONSTRAINTS
+from skmotion.tree._build import TREE_CONSTRAINTS, TreeParams
+from skmotion.tree._build._standardise import column_mean_std, standardise_in_place
 from skmotion.tree._encoding._columns import (
     _existing,
     _int_list,
@@ -251,23 +252,25 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             raise ValueError("moment_pyramid must name at least one level, e.g. (1,) or (1, 2, 4).")
         clips = check_clips(X, estimator=self, reset=True)
         frames, _ = stack_clips(clips)
-        self.moment_center_ = frames.mean(axis=0)
-        spread = frames.std(axis=0)
+        self.moment_center_, spread = column_mean_std(frames)  # no centred copy
         self.moment_scale_ = np.where(spread > 0, spread, 1.0)
         self.center_ = np.zeros(frames.shape[1])
         self.scale_ = np.ones(frames.shape[1])
         if self.standardize:
             self.center_, self.scale_ = self.moment_center_, self.moment_scale_
         say(self.verbose, f"MotionTreeEncoder: building the tree over {len(frames):,} frames")
-        self.tree_ = MotionTree.build(
-            (frames - self.center_) / self.scale_,
-            max_depth=build_depth(
-                self.max_depth, self.layers, self.transition_layers, self.residual_layers
-            ),
+        # standardised over the stacked copy itself, and the tree built in it: no other copy
+        z = standardise_in_place(frames, self.center_, self.scale_)
+        depth = build_depth(
+            self.max_depth, self.layers, self.transition_layers, self.residual_layers
+        )
+        params = TreeParams(
+            max_depth=depth,
             min_samples_leaf=self.min_samples_leaf,
             split=self.split,
             covariance_type="spherical",  # routing uses the splits only
         )
+        self.tree_ = MotionTree.from_params(z, params, copy=False)
         bottom = self.tree_.n_layers - 1
         wanted = range(1, bottom + 1) if _is_all(self.layers) else _int_list("layers", self.layers)
         self.layers_ = np.array(sorted({v for v in wanted if v <= bottom}), dtype=np.intp)
@@ -293,8 +296,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self._residual_means = [self.tree_.means(layer) for layer in self.residual_layers_]
         self._residual_variances = []
         if self.residual_order == 2 and len(self.residual_layers_):
-            z = (frames - self.center_) / self.scale_
-            nodes = self._router.route(frames, self.residual_layers_)
+            raw, _ = stack_clips(clips)  # routed as transform routes them: the raw frames
+            nodes = self._router.route(raw, self.residual_layers_)
+            del raw
             self._residual_variances = node_variances(z, nodes, self._residual_means)
         orders = 2 if self._residual_variances else 1
         n_residual = self.tree_.n_nodes[self.residual_layers_].sum() * orders
@@ -316,7 +320,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         X_new : ndarray or scipy.sparse.csr_matrix of shape (n_clips, n_features_out_)
             Or a DataFrame after ``set_output(transform="pandas")`` (dense output only).
         """
-        check_is_fitted(self)
+        check_is_fitted(self, "tree_")
         clips = check_clips(X, estimator=self)
         sparse = self._sparse()
         if sparse and self._output_config() == "pandas":
@@ -325,11 +329,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
                 f"{self.n_features_out_} columns as a sparse matrix: set sparse_output=False."
             )
         frames, offsets = stack_clips(clips)
-        routed = np.union1d(
-            np.union1d(self.layers_, self.transition_layers_), self.residual_layers_
-        )
+        layer_sets = (self.layers_, self.transition_layers_, self.residual_layers_)
+        routed = np.array(sorted({int(v) for layers in layer_sets for v in layers}), np.intp)
         # moments alone need no routing
         nodes = self._router.route(frames, routed) if len(routed) else None
+        residual_nodes = None
+        if len(self.residual_layers_):
+            residual_nodes = nodes[:, np.searchsorted(routed, self.residual_layers_)]
         parts = []
         if self._blocks:
             parts.append(histogram_features(nodes, offsets, routed, self._blocks, self.power))
@@ -337,7 +343,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             parts.append(
                 residual_features(
                     frames,
-                    nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                    residual_nodes,
                     offsets,
                     self._residual_means,
                     self.center_,
@@ -349,7 +355,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             parts.append(
                 second_order_features(
                     frames,
-                    nodes[:, np.searchsorted(routed, self.residual_layers_)],
+                    residual_nodes,
                     offsets,
                     self._residual_means,
                     self._residual_variances,
@@ -372,7 +378,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         if sparse:
             return sp.hstack(parts, format="csr") if len(parts) > 1 else sp.csr_matrix(parts[0])
         dense = [p.toarray() if sp.issparse(p) else p for p in parts]
-        return self._wrap_table(dense[0] if len(dense) == 1 else np.hstack(dense), clips)
+        table = dense[0] if len(dense) == 1 else np.concatenate(dense, axis=1)
+        return self._wrap_table(table, clips)
 
     def _sparse(self):
         if self.sparse_output == "auto":

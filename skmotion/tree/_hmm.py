@@ -20,6 +20,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
 from skmotion.tree._build import TREE_CONSTRAINTS, TreeParams
+from skmotion.tree._build._standardise import column_mean_std, standardise_in_place
 from skmotion.tree._calibration import (
     class_score_features,
     class_score_names,
@@ -308,12 +309,12 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
         self.center_ = np.zeros(frames.shape[1])
         self.scale_ = np.ones(frames.shape[1])
         if self.standardize:
-            self.center_ = frames.mean(axis=0)
-            spread = frames.std(axis=0)
+            # the mean and spread, then the standardisation, over the stacked copy itself
+            self.center_, spread = column_mean_std(frames)
             self.scale_ = np.where(spread > 0, spread, 1.0)
-            frames = (frames - self.center_) / self.scale_
+            standardise_in_place(frames, self.center_, self.scale_)
         say(self.verbose, f"MotionTreeHMM: building the tree over {len(frames):,} frames")
-        tree = MotionTree.from_params(frames, TreeParams.of(self))
+        tree = MotionTree.from_params(frames, TreeParams.of(self), copy=False)
         say(self.verbose, f"MotionTreeHMM: {tree.n_layers} layers; counting the transition graphs")
         labels = list(tree.iter_apply(frames))
         self._set_tree(tree)

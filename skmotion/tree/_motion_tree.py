@@ -125,6 +125,7 @@ class MotionTree(VersionedStateMixin):
         split=PAPER_TREE.split,
         covariance_type=PAPER_TREE.covariance_type,
         reg_covar=PAPER_TREE.reg_covar,
+        copy=True,
     ):
         """Build the tree over frames.
 
@@ -156,6 +157,12 @@ class MotionTree(VersionedStateMixin):
         reg_covar : float, default=1e-6
             Added to every variance, as a fraction of the mean per-channel
             variance of all frames (absolute when the frames do not vary).
+        copy : bool, default=True
+            False: when ``frames`` is a writable C-contiguous float64 array, the
+            build works in it, reordering its rows and putting them back in their
+            order at the end, so it holds no second copy of the frames (the same
+            tree; about 1.1 times the frames' memory at most instead of 2.1).
+            Do not read ``frames`` from another thread during the build.
 
         Returns
         -------
@@ -169,22 +176,35 @@ class MotionTree(VersionedStateMixin):
             covariance_type=covariance_type,
             reg_covar=reg_covar,
         )
-        return cls.from_params(frames, params)
+        return cls.from_params(frames, params, copy=copy)
 
     @classmethod
-    def from_params(cls, frames, params):
-        """Build the tree over frames with the parameters of a ``TreeParams``."""
+    def from_params(cls, frames, params, *, copy=True):
+        """Build the tree over frames with the parameters of a ``TreeParams``.
+
+        ``copy=False`` (for a caller's own C-contiguous float64 array, such as a
+        fit's stacked frames): the build works in ``frames`` itself, reordering
+        them and putting them back in their order at the end, so it holds no
+        second copy of the frames (the same tree).
+        """
         X = np.asarray(frames, dtype=np.float64)
         if X.ndim != 2 or len(X) == 0 or X.shape[1] == 0:
             raise ValueError(
                 f"frames must be a non-empty 2-D array (n_frames, n_channels); got shape {X.shape}."
             )
-        if not np.isfinite(X).all():
-            frame, channel = np.argwhere(~np.isfinite(X))[0]
-            raise ValueError(
-                f"frames must be finite; frame {frame}, channel {channel} is {X[frame, channel]}."
-            )
-        nodes = build_nodes(np.ascontiguousarray(X), **params.as_dict())
+        for start in range(0, len(X), _ROUTE_CHUNK):  # in blocks: no mask the size of X
+            block = X[start : start + _ROUTE_CHUNK]
+            if not np.isfinite(block).all():
+                frame, channel = np.argwhere(~np.isfinite(block))[0]
+                raise ValueError(
+                    f"frames must be finite; frame {start + frame}, channel {channel} is "
+                    f"{block[frame, channel]}."
+                )
+        X = np.ascontiguousarray(X)
+        # a conversion made a new array: the build may work in it, there is no other copy
+        owned = not isinstance(frames, np.ndarray) or not np.may_share_memory(X, frames)
+        in_place = (owned or not copy) and X.flags.writeable
+        nodes = build_nodes(X, **params.as_dict(), copy=not in_place)
         return cls(**nodes, covariance_type=params.covariance_type)
 
     # -- sizes and layer structure ------------------------------------------------

@@ -420,3 +420,20 @@ def test_online_state_is_a_fixed_mapping_that_pickles():
     for key in expected:
         np.testing.assert_array_equal(again[key], expected[key])
     assert "label=" in repr(again) and first.frame == 0 and first.lagged_node == -1
+
+
+def test_streams_share_the_models_tables_until_it_is_fit_again():
+    """The tables are made once per fitted model: a stream made after partial_fit answers as
+    one of a model that never made a stream (no stale table)."""
+    first = MotionTreeHMM(max_depth=3, min_samples_leaf=8).partial_fit(CLIPS[:6], LABELS[:6])
+    fresh = MotionTreeHMM(max_depth=3, min_samples_leaf=8).partial_fit(CLIPS[:6], LABELS[:6])
+    a, b = first.stream(), first.stream()
+    assert all(x[2] is y[2] for x, y in zip(a._layers, b._layers))  # shared, not remade
+    first.partial_fit(CLIPS[6:], LABELS[6:])
+    fresh.partial_fit(CLIPS[6:], LABELS[6:])
+    for mode in ("online", "exact"):
+        s, t = first.stream(mode=mode), fresh.stream(mode=mode)
+        for frame in CLIPS[7]:
+            x, y = s.update(frame), t.update(frame)
+        assert x.label == y.label and np.array_equal(x.proba, y.proba)
+        assert np.array_equal(x.nodes, y.nodes)

@@ -14,6 +14,7 @@ from scipy.linalg import eigh
 from scipy.linalg.lapack import dsyevr
 
 from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
+from skmotion.tree._build._permute import permute_rows
 from skmotion.tree._build._split import best_split
 
 __all__ = ["build_nodes"]
@@ -64,16 +65,28 @@ def _principal_axis(centred, scatter):
 
 
 class _Builder:
-    """Breadth-first construction on a copy of the frames in which every node's
-    frames are one contiguous block (splitting a node reorders its block)."""
+    """Breadth-first construction on the frames reordered so that every node's frames
+    are one contiguous block (splitting a node reorders its block in place).
+
+    The frames are a copy, or with ``copy=False`` the caller's own array, whose
+    order is put back after the build (``index`` follows every row)."""
 
     def __init__(
-        self, X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar
+        self,
+        X,
+        max_depth,
+        min_samples_split,
+        min_samples_leaf,
+        split,
+        covariance_type,
+        reg_covar,
+        copy=True,
     ):
         # Rounding of a projection x @ axis is below d * eps * max|x|; cuts must
         # sit in gaps far wider, so a training frame always routes back to its side.
         self.tol = _GAP_RESOLUTION * X.shape[1] * max(float(X.max()), -float(X.min()))
-        self.blocks = X.copy()
+        self.blocks = X.copy() if copy else X
+        self.index = None if copy else np.arange(len(X))
         self.reg_covar = reg_covar
         self.reg = None  # set from the root's variance
         self.root_scatter = None
@@ -139,10 +152,14 @@ class _Builder:
         proj = block @ axis  # as routing computes it
         order = np.argsort(proj, kind="stable")
         ordered = proj[order]
+        del proj
         n_left = best_split(ordered, self.split, min_samples_leaf=self.min_leaf, tol=self.tol)
         if n_left is None:
             return ()
-        self.blocks[start:stop] = block[order]
+        # in place, along the permutation's cycles: block[order] would copy the whole block
+        permute_rows(block, order)
+        if self.index is not None:
+            self.index[start:stop] = self.index[start:stop][order]
         depth = nodes["depth"][node] + 1
         left = self.add(node, depth, start, start + n_left)
         right = self.add(node, depth, start + n_left, stop)
@@ -169,18 +186,26 @@ class _Builder:
                 break
             layers.append(np.array(next_layer))
             depth += 1
+        if self.index is not None:  # the caller's frames back in their order
+            inverse = np.empty_like(self.index)
+            inverse[self.index] = np.arange(len(self.index))
+            self.index = None
+            permute_rows(self.blocks, inverse)
         return layers
 
 
 def build_nodes(
-    X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar
+    X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar, copy=True
 ):
     """Grow the tree over validated frames; the per-node arrays and the layers.
 
     Parameters
     ----------
     X : ndarray of shape (n_frames, n_channels)
-        C-contiguous, finite frames.
+        C-contiguous, finite float64 frames.
+    copy : bool, default=True
+        False: work in ``X`` itself (no copy of the frames), which is reordered
+        during the build and put back in its order at the end (the same values).
     max_depth, min_samples_split, min_samples_leaf, split, covariance_type
         As for :meth:`MotionTree.build`.
     reg_covar : float
@@ -198,7 +223,7 @@ def build_nodes(
         absolute regularisation): the arguments of ``MotionTree``.
     """
     builder = _Builder(
-        X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar
+        X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar, copy
     )
     layers = builder.run()
     nodes = builder.nodes

@@ -9,6 +9,8 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
+from skmotion.utils._group_sums import group_sums
+
 __all__ = [
     "feature_blocks",
     "histogram_features",
@@ -126,23 +128,25 @@ def residual_features(frames, nodes, offsets, means, center, scale, power):
     features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
     """
     n_clips = len(offsets) - 1
+    clip_weights = _clip_weights(offsets)
     blocks = []
     for j, mean in enumerate(means):
         k = len(mean)
-        # one sparse product sums every (clip, node) group of raw frames;
+        # one pass sums every (clip, node) group of raw frames;
         # sum (x - c) / s - mean = (sum x - share c) / s - share mean, share = sum 1 / n
-        (sums,), share = _node_averages([frames], nodes[:, j], offsets, k)
+        (sums,), share = _node_averages([frames], nodes[:, j], clip_weights, k)
         block = ((sums - share * center) / scale).reshape(n_clips, k, -1)
         block = (block - share.reshape(n_clips, k, 1) * mean).reshape(n_clips, -1)
         blocks.append(_signed_power_unit_norm(block, power))
-    return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))
+    return np.concatenate(blocks, axis=1) if blocks else np.zeros((n_clips, 0))
 
 
 def _signed_power_unit_norm(block, power):
     """``sign(b) |b| ** power`` per entry, then each row scaled to unit Euclidean norm."""
     if power != 1:
         block = np.sign(block) * np.abs(block) ** power
-    norm = np.linalg.norm(block, axis=1, keepdims=True)
+    # np.linalg.norm's own arithmetic (sqrt of the row sums of squares), without its checks
+    norm = np.sqrt(np.add.reduce(block * block, axis=1, keepdims=True))
     return block / np.where(norm > 0, norm, 1.0)
 
 
@@ -180,11 +184,8 @@ def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
         The means cell by cell (level by level, cells in time order, each cell
         every channel), then the root mean squares.
     """
-    lengths = np.diff(offsets)
+    lengths = offsets[1:] - offsets[:-1]  # np.diff, without its checks
     clip = np.repeat(np.arange(len(lengths)), lengths)
-    average = sp.csr_matrix(
-        (1.0 / lengths[clip], (clip, np.arange(len(frames)))), shape=(len(lengths), len(frames))
-    )
     # one centred copy, squared in place, the scale applied to the sums: a pass over a batch's
     # frames costs as much as the sums themselves
     centred = np.subtract(frames, center)
@@ -193,8 +194,9 @@ def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
     ]
     if order >= 2:
         np.square(centred, out=centred)
-        blocks.append(np.sqrt(average @ centred) / scale - 1.0)
-    return np.hstack(blocks)
+        mean_squares = group_sums(centred, clip, 1.0 / lengths[clip], len(lengths))
+        blocks.append(np.sqrt(mean_squares) / scale - 1.0)
+    return np.concatenate(blocks, axis=1)
 
 
 def _cell_means(centred, clip, lengths, parts):
@@ -207,17 +209,13 @@ def _cell_means(centred, clip, lengths, parts):
     time order.
     """
     n_clips = len(lengths)
+    if parts == 1:  # the clips themselves: no cell is empty
+        return group_sums(centred, clip, 1.0 / lengths[clip], n_clips)
     starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
-    if parts == 1:
-        cell = np.zeros(len(clip), dtype=np.intp)
-    else:
-        cell = (np.arange(len(clip)) - starts[clip]) * parts // lengths[clip]
+    cell = (np.arange(len(clip)) - starts[clip]) * parts // lengths[clip]
     key = clip * parts + cell
     size = np.bincount(key, minlength=n_clips * parts)
-    average = sp.csr_matrix(
-        (1.0 / size[key], (key, np.arange(len(clip)))), shape=(n_clips * parts, len(clip))
-    )
-    means = average @ centred
+    means = group_sums(centred, key, 1.0 / size[key], n_clips * parts)
     empty = np.flatnonzero(size == 0)
     if len(empty):
         owner, c = np.divmod(empty, parts)
@@ -225,20 +223,27 @@ def _cell_means(centred, clip, lengths, parts):
     return means.reshape(n_clips, parts * centred.shape[1])
 
 
-def _node_averages(values, nodes, offsets, k):
+def _clip_weights(offsets):
+    """Each frame's clip, ``1 / length`` of its clip, and the clips, for :func:`_node_averages`."""
+    lengths = offsets[1:] - offsets[:-1]  # np.diff, without its checks
+    clip = np.repeat(np.arange(len(lengths)), lengths)
+    return clip, 1.0 / lengths[clip], len(lengths)
+
+
+def _node_averages(values, nodes, clip_weights, k):
     """Per clip and node: the sums of ``values`` over the clip's frames in the node / its frames.
 
-    ``values`` is a list of arrays of shape (n_frames, n_channels), summed by one
-    sparse (clip, node) x frame matrix; also returns each group's share of its clip's frames.
+    ``values`` is a list of arrays of shape (n_frames, n_channels), each summed per
+    (clip, node) group in frame order (the compiled ``group_sums``: the doubles of the
+    sparse (clip, node) x frame product, without building the matrix, whose making
+    dominated a call on one clip); ``clip_weights`` is :func:`_clip_weights`. Also
+    returns each group's share of its clip's frames.
     """
-    n_clips, n_frames = len(offsets) - 1, len(nodes)
-    lengths = np.diff(offsets)
-    clip = np.repeat(np.arange(n_clips), lengths)
-    weight = 1.0 / lengths[clip]
+    clip, weight, n_clips = clip_weights
+    n_groups = n_clips * k
     group = clip * k + nodes
-    average = sp.csr_matrix((weight, (group, np.arange(n_frames))), shape=(n_clips * k, n_frames))
-    share = np.bincount(group, weights=weight, minlength=n_clips * k)[:, None]
-    return [average @ v for v in values], share
+    share = np.bincount(group, weights=weight, minlength=n_groups)[:, None]
+    return [group_sums(v, group, weight, n_groups) for v in values], share
 
 
 def node_variances(z, nodes, means):
@@ -285,12 +290,13 @@ def second_order_features(frames, nodes, offsets, means, variances, center, scal
     # a few at most, so the expansion loses nothing that matters)
     centred = np.subtract(frames, center)
     squares = centred * centred
+    clip_weights = _clip_weights(offsets)
     blocks = []
     for j, (mean, variance) in enumerate(zip(means, variances)):
         k = len(mean)
-        (first, second), share = _node_averages([centred, squares], nodes[:, j], offsets, k)
+        (first, second), share = _node_averages([centred, squares], nodes[:, j], clip_weights, k)
         mean_rows, variance_rows = np.tile(mean, (n_clips, 1)), np.tile(variance, (n_clips, 1))
         spread = second / scale**2 - 2 * mean_rows * first / scale + share * mean_rows**2
         block = (spread / variance_rows - share).reshape(n_clips, -1)
         blocks.append(_signed_power_unit_norm(block, power))
-    return np.hstack(blocks) if blocks else np.zeros((n_clips, 0))
+    return np.concatenate(blocks, axis=1) if blocks else np.zeros((n_clips, 0))

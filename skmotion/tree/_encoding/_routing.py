@@ -57,6 +57,23 @@ class TreeRouter:
         for layer, ids in enumerate(tree.layers):
             self.layer_index[layer, ids] = np.arange(len(ids))
         self.split_ids = [ids[tree.left[ids] >= 0] for ids in tree.layers]
+        self._derive()
+
+    def _derive(self):
+        """The lookup tables of a step, from the splits (also for a router pickled without them)."""
+        # the child on each side, a leaf being its own (copied down): one step is then a
+        # choice between two lookups for every frame
+        own = np.arange(len(self.left))
+        self.left_or_self = np.where(self.left >= 0, self.left, own)
+        self.right_or_self = np.where(self.right >= 0, self.right, own)
+        # layers whose split axes go into the one product (see _route_block)
+        self.in_product = np.array([0 < len(ids) <= _DENSE_LIMIT for ids in self.split_ids])
+        self._products = {}  # per deepest layer routed: the product's axes, each node's column
+
+    def __setstate__(self, state):
+        self.__dict__.update(state)
+        if "_products" not in state:  # pickled by a version whose router had no tables
+            self._derive()
 
     def route(self, frames, layers=None):
         """Layer index of each frame's node in each of ``layers``.
@@ -75,6 +92,8 @@ class TreeRouter:
         """
         frames = np.asarray(frames, dtype=np.float64)
         layers = np.arange(self.n_layers) if layers is None else np.asarray(layers, np.intp)
+        if len(frames) <= _CHUNK:
+            return self._route_block(frames, layers)
         out = np.empty((len(frames), len(layers)), dtype=np.intp)
         for start in range(0, len(frames), _CHUNK):
             block = slice(start, start + _CHUNK)
@@ -84,16 +103,11 @@ class TreeRouter:
     def _route_block(self, frames, layers):
         out = np.empty((len(frames), len(layers)), dtype=np.intp)
         node = np.zeros(len(frames), dtype=np.intp)  # tree node ids, from the root
-        # The split axes of the upper layers (few nodes each) in one product: one read of frames.
-        upper = [ids for ids in self.split_ids[: layers[-1]] if 0 < len(ids) <= _DENSE_LIMIT]
-        column = np.full(len(self.left), -1, dtype=np.intp)
-        proj = None
-        if upper:
-            ids = np.concatenate(upper)
-            column[ids] = np.arange(len(ids))
-            # einsum, not BLAS: a product this thin gains nothing from BLAS's threads, and on a
-            # busy machine their hand-offs cost 50-100x the arithmetic (measured).
-            proj = np.einsum("ij,kj->ik", frames, self.axis[ids])
+        axes, column = self._product(int(layers[-1]))
+        # einsum, not BLAS: a product this thin gains nothing from BLAS's threads, and on a
+        # busy machine their hand-offs cost 50-100x the arithmetic (measured).
+        proj = np.einsum("ij,kj->ik", frames, axes) if len(axes) else None
+        rows = np.arange(len(frames))
         k = 0
         for layer in range(layers[-1] + 1):
             if layer == layers[k]:
@@ -101,20 +115,37 @@ class TreeRouter:
                 k += 1
             if layer == layers[-1]:
                 break
-            node = self._step(frames, node, layer, proj, column)
+            if proj is not None and self.in_product[layer]:
+                # this layer's axes are in the product (a leaf's column is -1: any value,
+                # since both of its sides are itself)
+                right = proj[rows, column[node]] > self.threshold[node]
+                node = np.where(right, self.right_or_self[node], self.left_or_self[node])
+            else:
+                node = self._step(frames, node)
         return out
 
-    def _step(self, frames, node, layer, proj, column):
-        """Every frame's node one layer down (a leaf copied down stays itself)."""
+    def _product(self, last):
+        """The split axes of the upper layers above ``last`` (few nodes each), applied to all
+        frames in one product (one read of the frames), and each tree node's column there."""
+        if last not in self._products:
+            upper = [
+                ids for layer, ids in enumerate(self.split_ids[:last]) if self.in_product[layer]
+            ]
+            column = np.full(len(self.left), -1, dtype=np.intp)
+            ids = np.concatenate(upper) if upper else np.zeros(0, dtype=np.intp)
+            column[ids] = np.arange(len(ids))
+            self._products[last] = (np.ascontiguousarray(self.axis[ids]), column)
+        return self._products[last]
+
+    def _step(self, frames, node):
+        """Every frame's node one layer down, each frame's own axis gathered (a leaf copied
+        down stays itself)."""
         splits = self.left[node] >= 0
         if not splits.any():
             return node
         rows = np.flatnonzero(splits)
         ids = node[rows]
-        if proj is not None and column[ids[0]] >= 0:  # this layer's axes are in the product
-            values = proj[rows, column[ids]]
-        else:
-            values = np.einsum("ij,ij->i", frames[rows], self.axis[ids])
+        values = np.einsum("ij,ij->i", frames[rows], self.axis[ids])
         right = np.zeros(len(frames), dtype=bool)
         right[rows] = values > self.threshold[ids]
         return np.where(splits, np.where(right, self.right[node], self.left[node]), node)

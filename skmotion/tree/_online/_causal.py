@@ -45,7 +45,7 @@ import numpy as np
 
 from skmotion.tree._calibration import sum_of_paths
 from skmotion.tree._decoder._decode import _log_normaliser
-from skmotion.tree._decoder._tables import gaussian_arrays
+from skmotion.tree._decoder._tables import _cached, gaussian_arrays
 from skmotion.tree._online._exact import layer_ancestors, stream_args, update_frames
 from skmotion.tree._online._kernel import OnlineKernel
 from skmotion.utils._validation import check_int
@@ -58,23 +58,54 @@ def _transition_table(graph_sets, layer):
 
     Column ``c`` is the ``c``-th graph of ``graph_sets`` (each a
     :class:`TransitionGraphs`, its graphs in order); ``unseen_log[m, c]`` is a
-    never-seen transition from ``m``. The values are ``log_prob``'s.
+    never-seen transition from ``m``. The values are ``log_prob``'s, looked up
+    for all graphs of a set at once (one broadcast call, not one per graph).
     """
     k = graph_sets[0].n_nodes(layer)
-    columns = [(graphs, g) for graphs in graph_sets for g in range(graphs.n_graphs)]
-    keys = [graphs.counts(layer, g).tocoo() for graphs, g in columns]
-    pairs = np.unique(np.concatenate([c.row * k + c.col for c in keys]).astype(np.intp))
+    keys = []
+    for graphs in graph_sets:
+        stacked = graphs.stacked_counts(layer)  # graph g: rows g K .. (g + 1) K - 1
+        rows = np.repeat(np.arange(stacked.shape[0], dtype=np.intp), np.diff(stacked.indptr))
+        keys.append((rows % k) * k + stacked.indices)
+    pairs = np.unique(np.concatenate(keys).astype(np.intp))
     src, dst = np.divmod(pairs, k)
-    pair_log = np.stack([graphs.log_prob(layer, g, src, dst) for graphs, g in columns], axis=1)
-    unseen = np.stack(
-        [np.log(graphs.unseen_probability(layer)[g]) for graphs, g in columns], axis=1
+    pair_log = np.concatenate(
+        [
+            graphs.log_prob(layer, np.arange(graphs.n_graphs)[None, :], src[:, None], dst[:, None])
+            for graphs in graph_sets
+        ],
+        axis=1,
     )
+    with np.errstate(divide="ignore"):
+        unseen = np.concatenate(
+            [np.log(graphs.unseen_probability(layer)).T for graphs in graph_sets], axis=1
+        )
     return (
         np.searchsorted(src, np.arange(k + 1)).astype(np.intp),
         np.ascontiguousarray(dst, dtype=np.intp),
-        np.ascontiguousarray(pair_log, dtype=np.float64).reshape(len(pairs), len(columns)),
+        np.ascontiguousarray(pair_log, dtype=np.float64).reshape(len(pairs), -1),
         np.ascontiguousarray(unseen, dtype=np.float64),
     )
+
+
+def _layer_tables(model, depth, scored):
+    """A layer's children, node ids and transition table as the kernel reads them.
+
+    Made once per model state and kept while its global graph lives (the
+    decoder's weak-keyed cache): ``fit`` and ``partial_fit`` make new graphs,
+    so a refitted model gets new tables, and a stream costs no conversion.
+    The kernel only reads them, so every stream of the model shares them.
+    """
+    tree = model.tree_
+    key = ("online layer", depth, model.graphs_ if scored else None, tree)
+
+    def make():
+        sets = [model.global_graph_] + ([model.graphs_] if scored else [])
+        children = np.ascontiguousarray(tree.children(depth - 1), dtype=np.intp)
+        ids = np.ascontiguousarray(tree.node_ids(depth), dtype=np.intp)
+        return (children, ids, *_transition_table(sets, depth))
+
+    return _cached(model.global_graph_, key, make)
 
 
 class OnlineMotionStream:
@@ -131,7 +162,11 @@ class OnlineMotionStream:
         self.beam = check_int("beam", model.n_paths if beam is None else beam, 1)
         self.n_best = min(check_int("n_best", n_best, 0), int(tree.n_nodes[self.layer]))
         # row k: node k's ancestors at layers 0 .. layer
-        self._ancestors = np.stack(layer_ancestors(tree, self.layer), axis=1)
+        self._ancestors = _cached(
+            tree,
+            ("online ancestors", self.layer),
+            lambda: np.stack(layer_ancestors(tree, self.layer), axis=1),
+        )
         n_channels = model.n_features_in_
         self._center = np.ascontiguousarray(model.center_, dtype=np.float64)
         self._scale = np.ascontiguousarray(model.scale_, dtype=np.float64)
@@ -148,22 +183,19 @@ class OnlineMotionStream:
         self.reset()
 
     def _build(self):
-        """The model's tables as the kernel reads them, made once per stream."""
+        """The model's tables as the kernel reads them (made once per fitted model, shared)."""
         model, tree = self.model, self._tree
         self._gauss = gaussian_arrays(tree)  # the batch decoder's layout: one for both kernels
         self._layers, self._norms = [], {}
         for depth in range(1, self._depth + 1):
             scored = depth in self._scored
-            sets = [model.global_graph_] + ([model.graphs_] if scored else [])
             allowed = np.zeros((0, 0), dtype=np.uint8)
             norm = np.zeros(0)
             if scored and model.node_prior == "graph":
                 allowed = np.ascontiguousarray(model.graphs_.visits(depth) > 0, dtype=np.uint8)
                 norm = self._norms[depth] = np.zeros(self._n_graphs)
-            children = np.ascontiguousarray(tree.children(depth - 1), dtype=np.intp)
-            ids = np.ascontiguousarray(tree.node_ids(depth), dtype=np.intp)
-            table = _transition_table(sets, depth)
-            self._layers.append((children, ids, *table, allowed, norm, scored))
+            tables = _layer_tables(model, depth, scored)
+            self._layers.append((*tables, allowed, norm, scored))
         self._global = self._layers[self.layer - 1][2:5] if self.layer else None
 
     def _new_state(self):

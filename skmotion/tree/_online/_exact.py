@@ -22,6 +22,7 @@ from sklearn.utils import Bunch
 
 from skmotion.tree._calibration import log_softmax_rows, per_frame, sum_of_paths
 from skmotion.tree._decoder._decode import beam_decode
+from skmotion.tree._decoder._tables import _cached
 from skmotion.tree._transitions import TransitionGraphs
 from skmotion.utils._validation import check_int
 
@@ -107,7 +108,12 @@ class MotionStream:
         # they are the same doubles; a layer's scores do not depend on the layers scored).
         self._combined = None
         if self.layer == model.layer_:
-            self._combined = _side_by_side(model.graphs_, model.global_graph_)
+            # made once per fitted graphs (the decoder's weak-keyed cache), not per stream
+            self._combined = _cached(
+                model.global_graph_,
+                ("exact combined", model.graphs_),
+                lambda: _side_by_side(model.graphs_, model.global_graph_),
+            )
         self._buffer = np.empty((64, tree.n_channels))
         self.n_frames = 0
 
