@@ -73,4 +73,15 @@ occurrence_loops = Extension(
     ["skmotion/neighbors/_occurrence_loops.pyx"],
     extra_compile_args=["-O3"],
 )
-setup(ext_modules=cythonize([*beam, *online, position_frame, leading, psi_rank, occurrence_loops]))
+# Frame features and window scores of the linear gesture detector, one frame at a time
+# (live/_linear_detector.py).
+live_window = Extension(
+    "skmotion.live._window_kernel",
+    ["skmotion/live/_window_kernel.pyx"],
+    extra_compile_args=["-O3"],
+)
+setup(
+    ext_modules=cythonize(
+        [*beam, *online, position_frame, leading, psi_rank, occurrence_loops, live_window]
+    )
+)
