@@ -17,7 +17,7 @@ from sklearn.model_selection import GroupKFold
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from skmotion.live import ActivitySegmenter, GestureDetector
+from skmotion.live import ActivitySegmenter, GestureDetector, LinearGestureDetector
 from skmotion.live._events import TRIGGERS, TriggerState, next_events
 from skmotion.live._segmenter import runs
 from skmotion.metrics import detection_counts
@@ -27,7 +27,7 @@ from skmotion.tree import MotionTreeEncoder
 RATE = 15  # frames per second of the stored MSRC-12
 FIGURE = Path(__file__).resolve().parents[1] / "docs" / "images" / "live_detection.png"
 LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
-THRESHOLDS = np.round(np.linspace(0.05, 0.95, 19), 2)
+THRESHOLDS = np.r_[np.round(np.linspace(0.05, 0.95, 19), 2), 0.97, 0.99]
 REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
 GESTURES = (
     "lift arms", "duck", "push right", "goggles", "wind it up", "shoot",
@@ -155,8 +155,31 @@ def _cost_per_frame(detector, take, rounds=3):
     return 1e6 * float(np.median(per_frame)), 1e6 * float(np.median(calls)), 1e6 * batched
 
 
-def detection(quick, step=2, window=30):
-    """F1 per gesture and latency, both recognisers, with the chosen thresholds."""
+LINEAR = "skmotion: LinearGestureDetector (segment means of hip-centred frames, compiled)"
+
+
+def detectors(step, window, chosen=None):
+    """The detectors compared: GestureDetector over each recogniser, and LinearGestureDetector.
+
+    ``chosen``: names (or parts of names) to keep; None keeps all.
+    """
+    found = {
+        name: GestureDetector(
+            recognizer=recogniser, window=window, step=step, n_negatives=10, random_state=0
+        )
+        for name, recogniser in recognisers().items()
+    }
+    # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size)
+    found[LINEAR] = LinearGestureDetector(
+        n_segments=5, segment=window // 5, root=0, size_joints=(0, 2), random_state=0
+    )
+    if chosen:
+        found = {k: v for k, v in found.items() if any(c.lower() in k.lower() for c in chosen)}
+    return found
+
+
+def detection(quick, step=2, window=30, chosen=None):
+    """F1 per gesture and latency, every detector, with the event rule chosen by CV."""
     takes, aps, gestures, people = msrc12()
     train = np.flatnonzero(people % 2 == 1)
     test = np.flatnonzero(people % 2 == 0)
@@ -165,11 +188,7 @@ def detection(quick, step=2, window=30):
     Xtr, Xte = [takes[i] for i in train], [takes[i] for i in test]
     names = [np.full(len(aps[i]), gestures[i], dtype=object) for i in test]
     rows, fitted = [], {}
-    for name, recogniser in recognisers().items():
-        params = dict(
-            recognizer=recogniser, window=window, step=step, n_negatives=10, random_state=0
-        )
-        detector = GestureDetector(**params)
+    for name, detector in detectors(step, window, chosen).items():
         start = time.perf_counter()
         cv_f1, rule = _choose(
             detector, Xtr, [aps[i] for i in train], gestures[train], people[train]

@@ -364,7 +364,7 @@ class LinearDetectorStream:
         self._args = (d.weights_, d.bias_, *d._joints(), d.segment, d.none_index_)
         self._classes, self._none = d.classes_, d.none_index_
         self._rule = dict(threshold=d.threshold, refractory=d.refractory, trigger=d.trigger)
-        self._threshold = d.threshold
+        self._threshold, self._fall = d.threshold, d.trigger == "fall"
         n_classes = len(d.classes_)
         self._ring = np.zeros((d.window, d.n_segments, n_classes))
         self._previous = np.zeros(d.n_features_in_)
@@ -413,9 +413,15 @@ class LinearDetectorStream:
         frames = np.ascontiguousarray(frames, dtype=float)
         width = len(self._previous)
         if frames.shape == (width,):  # the one-frame path: no copies, one compiled call
-            proba, score, _ = self._score(frames.reshape(1, width), self._one)
-            if score[0] < self._threshold and self._state.run_best is None:
-                return []  # below the threshold and no run open: the rule would do nothing
+            proba, score, best = self._score(frames.reshape(1, width), self._one)
+            state, top = self._state, float(score[0])
+            # the two cases in which next_events would emit nothing, said in scalars
+            if state.run_best is None and top < self._threshold:
+                return []  # below the threshold and no run open: nothing changes
+            if self._fall and state.run_best is not None and top >= self._threshold:
+                if top > state.run_score:  # a run goes on: it keeps its best motion
+                    self._state = state._replace(run_best=best[0], run_score=top)
+                return []
             start = self.n_frames - 1
         else:
             if frames.ndim != 2 or frames.shape[1] != width:
