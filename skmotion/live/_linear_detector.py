@@ -76,7 +76,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         Needs channels in joint order, three per joint.
     size_joints : (int, int), default=None
         Two joints whose distance divides the positions; None: no division.
-    C : float, default=1.0
+    C : float, default=0.1
         Inverse regularisation of the logistic regression (on standardised segment means).
     threshold : float, default=0.5
         The probability of the best motion that starts (``"rise"``) or whose
@@ -128,11 +128,12 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     ...     take[end - 19 : end + 1] += np.linspace(0, 1, 20)[:, None]
     >>> detector = LinearGestureDetector(segment=4, random_state=0)
     >>> detector = detector.fit([take], ["rise"], action_points=[points])
+    >>> # trigger="fall": a few frames after each completion, as the score drops
     >>> [event.frame for event in detector.detect([take])[0]]
-    [50, 121, 190, 260, 331]
+    [54, 124, 194, 264, 334]
     >>> stream = detector.stream()                       # the same, one frame at a time
     >>> [event.frame for frame in take for event in stream.update(frame)]
-    [50, 121, 190, 260, 331]
+    [54, 124, 194, 264, 334]
     """
 
     _parameter_constraints = {
@@ -159,7 +160,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         segment=6,
         root=None,
         size_joints=None,
-        C=1.0,
+        C=0.1,
         threshold=0.5,
         refractory=15,
         trigger="fall",
