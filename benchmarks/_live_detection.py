@@ -140,19 +140,25 @@ def _choose(detector, takes, aps, labels, people):
 
 def _cost_per_frame(detector, take, rounds=3):
     """Microseconds per frame: the stream one frame per call (mean per frame, median of
-    rounds), the median single call (most frames score no window), and detect()."""
-    per_frame, calls = [], []
+    rounds), the median single call (most frames score no window), the thread's CPU time
+    per frame one per call (median of rounds: what a shared machine disturbs least), and
+    detect()."""
+    per_frame, calls, cpu = [], [], []
     for _ in range(rounds):
         stream = detector.stream()
+        started = time.thread_time()
         for frame in take:
             start = time.perf_counter()
             stream.update(frame)
             calls.append(time.perf_counter() - start)
+        cpu.append((time.thread_time() - started) / len(take))
         per_frame.append(float(np.sum(calls[-len(take) :])) / len(take))
     start = time.perf_counter()
     detector.detect([take])
     batched = (time.perf_counter() - start) / len(take)
-    return 1e6 * float(np.median(per_frame)), 1e6 * float(np.median(calls)), 1e6 * batched
+    return tuple(
+        1e6 * float(v) for v in (np.median(per_frame), np.median(calls), np.median(cpu), batched)
+    )
 
 
 LINEAR = "skmotion: LinearGestureDetector (segment means of hip-centred frames, compiled)"
@@ -201,7 +207,7 @@ def detection(quick, step=2, window=30, chosen=None):
         stream = detector.stream()  # the stream gives the batch's events (one take checked)
         streamed = [e for frame in Xte[0] for e in stream.update(frame)]
         same = [(e.frame, e.label) for e in streamed] == [(e.frame, e.label) for e in events[0]]
-        per_call, median_call, batched = _cost_per_frame(detector, Xte[0][:300])
+        per_call, median_call, cpu, batched = _cost_per_frame(detector, Xte[0][:300])
         for latency in LATENCIES:
             for early_name, early in (("+-", None), ("after only", 0)):
                 frames = int(round(latency * RATE))
@@ -224,6 +230,7 @@ def detection(quick, step=2, window=30, chosen=None):
                         "stream events = batch": same,
                         "us per frame, one per call": per_call,
                         "us per call, median": median_call,
+                        "CPU us per frame, one per call": cpu,
                         "us per frame, batched": batched,
                         "fit + CV s": fit_s,
                     }
