@@ -430,8 +430,10 @@ class LinearDetectorStream:
                     f"update: frames must have {width} channels, got an array of shape "
                     f"{frames.shape}."
                 )
+            if not len(frames):
+                return []
             start = self.n_frames
-            proba, score, _ = self._score(np.ascontiguousarray(frames))
+            proba, score, _ = self._score(frames)
             self.last_proba[:] = proba[-1] if score[-1] >= 0 else self.last_proba
         full = score >= 0
         ends = np.arange(start, start + len(score))[full]

@@ -100,6 +100,7 @@ def test_the_stream_equals_the_batch_to_the_bit(fitted, skeleton_takes, chunk):
     np.testing.assert_array_equal(last[-1], proba[-1])
     stream.reset()
     assert [e for frame in take for e in stream.update(frame)] == batch
+    assert stream.update(take[:0]) == [] and stream.n_frames == len(take)  # an empty chunk
 
 
 def test_the_stream_memory_does_not_grow(fitted, skeleton_takes):
