@@ -193,12 +193,12 @@ def _msrc12_detection(context, lines):
     lines += save_figure(
         context,
         "msrc12_detection.png",
-        _draw_detection(detector, ends, proba, held_points[0], events),
+        _draw_detection(detector, ends, proba, held_points[0], events, gesture),
         "a held-out MSRC-12 take: the best gesture's probability, action points and events",
     )
 
 
-def _draw_detection(detector, ends, proba, points, events, rate=15.0):
+def _draw_detection(detector, ends, proba, points, events, gesture, rate=15.0):
     def draw(plotting):
         import matplotlib.pyplot as plt
 
@@ -212,6 +212,7 @@ def _draw_detection(detector, ends, proba, points, events, rate=15.0):
         ax.set_xlabel("time (s)")
         ax.set_ylabel("probability")
         ax.set_ylim(0, 1.1)
+        ax.set_title(f"A held-out MSRC-12 take ('{gesture}'), streamed frame by frame", fontsize=10)
         ax.legend(loc="lower right", fontsize=7, ncol=4)
         fig.tight_layout()
         return fig
