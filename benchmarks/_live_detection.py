@@ -289,7 +289,7 @@ def figure(detectors, take, points, gesture, path):
         ax.set_ylabel("probability")
         ax.set_title(f"{name} (trigger {detector.trigger!r})", fontsize=9)
     ax.set_xlabel("time (s)")
-    np.atleast_1d(axes)[0].legend(loc="lower left", fontsize=7, ncol=5)
+    np.atleast_1d(axes)[0].legend(loc="upper right", fontsize=7, ncol=3)
     fig.tight_layout()
     path.parent.mkdir(exist_ok=True)
     fig.savefig(path, dpi=100)
