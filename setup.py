@@ -88,6 +88,13 @@ permute = Extension(
     ["skmotion/tree/_build/_permute.pyx"],
     extra_compile_args=["-O3"],
 )
+# Frame features and window scores of the linear gesture detector, one frame at a time
+# (live/_linear_detector.py).
+live_window = Extension(
+    "skmotion.live._window_kernel",
+    ["skmotion/live/_window_kernel.pyx"],
+    extra_compile_args=["-O3"],
+)
 setup(
     ext_modules=cythonize(
         [
@@ -99,6 +106,7 @@ setup(
             occurrence_loops,
             group_sums,
             permute,
+            live_window,
         ]
     )
 )

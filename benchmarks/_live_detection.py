@@ -17,7 +17,7 @@ from sklearn.model_selection import GroupKFold
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
 
-from skmotion.live import ActivitySegmenter, GestureDetector
+from skmotion.live import ActivitySegmenter, GestureDetector, LinearGestureDetector
 from skmotion.live._events import TRIGGERS, TriggerState, next_events
 from skmotion.live._segmenter import runs
 from skmotion.metrics import detection_counts
@@ -27,8 +27,9 @@ from skmotion.tree import MotionTreeEncoder
 RATE = 15  # frames per second of the stored MSRC-12
 FIGURE = Path(__file__).resolve().parents[1] / "docs" / "images" / "live_detection.png"
 LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
-THRESHOLDS = np.round(np.linspace(0.05, 0.95, 19), 2)
+THRESHOLDS = np.r_[np.round(np.linspace(0.05, 0.95, 19), 2), 0.97, 0.99]
 REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
+LINEAR_C = (0.01, 0.1)  # LinearGestureDetector's C, chosen by the same GroupKFold
 GESTURES = (
     "lift arms", "duck", "push right", "goggles", "wind it up", "shoot",
     "bow", "throw", "had enough", "change weapon", "beat both", "kick",
@@ -140,23 +141,52 @@ def _choose(detector, takes, aps, labels, people):
 
 def _cost_per_frame(detector, take, rounds=3):
     """Microseconds per frame: the stream one frame per call (mean per frame, median of
-    rounds), the median single call (most frames score no window), and detect()."""
-    per_frame, calls = [], []
+    rounds), the median single call (most frames score no window), the thread's CPU time
+    per frame one per call (median of rounds: what a shared machine disturbs least), and
+    detect()."""
+    per_frame, calls, cpu = [], [], []
     for _ in range(rounds):
         stream = detector.stream()
+        started = time.thread_time()
         for frame in take:
             start = time.perf_counter()
             stream.update(frame)
             calls.append(time.perf_counter() - start)
+        cpu.append((time.thread_time() - started) / len(take))
         per_frame.append(float(np.sum(calls[-len(take) :])) / len(take))
     start = time.perf_counter()
     detector.detect([take])
     batched = (time.perf_counter() - start) / len(take)
-    return 1e6 * float(np.median(per_frame)), 1e6 * float(np.median(calls)), 1e6 * batched
+    return tuple(
+        1e6 * float(v) for v in (np.median(per_frame), np.median(calls), np.median(cpu), batched)
+    )
 
 
-def detection(quick, step=2, window=30):
-    """F1 per gesture and latency, both recognisers, with the chosen thresholds."""
+LINEAR = "skmotion: LinearGestureDetector (segment means of hip-centred frames, compiled)"
+
+
+def detectors(step, window, chosen=None):
+    """The detectors compared: GestureDetector over each recogniser, and LinearGestureDetector.
+
+    ``chosen``: names (or parts of names) to keep; None keeps all.
+    """
+    found = {
+        name: GestureDetector(
+            recognizer=recogniser, window=window, step=step, n_negatives=10, random_state=0
+        )
+        for name, recogniser in recognisers().items()
+    }
+    # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size)
+    found[LINEAR] = LinearGestureDetector(
+        n_segments=5, segment=window // 5, root=0, size_joints=(0, 2), random_state=0
+    )
+    if chosen:
+        found = {k: v for k, v in found.items() if any(c.lower() in k.lower() for c in chosen)}
+    return found
+
+
+def detection(quick, step=2, window=30, chosen=None):
+    """F1 per gesture and latency, every detector, with the event rule chosen by CV."""
     takes, aps, gestures, people = msrc12()
     train = np.flatnonzero(people % 2 == 1)
     test = np.flatnonzero(people % 2 == 0)
@@ -165,15 +195,21 @@ def detection(quick, step=2, window=30):
     Xtr, Xte = [takes[i] for i in train], [takes[i] for i in test]
     names = [np.full(len(aps[i]), gestures[i], dtype=object) for i in test]
     rows, fitted = [], {}
-    for name, recogniser in recognisers().items():
-        params = dict(
-            recognizer=recogniser, window=window, step=step, n_negatives=10, random_state=0
-        )
-        detector = GestureDetector(**params)
+    for name, detector in detectors(step, window, chosen).items():
         start = time.perf_counter()
-        cv_f1, rule = _choose(
-            detector, Xtr, [aps[i] for i in train], gestures[train], people[train]
-        )
+        # the linear detector's regularisation is chosen with its event rule, on the same folds
+        grid = [{"C": c} for c in LINEAR_C] if isinstance(detector, LinearGestureDetector) else [{}]
+        found = []
+        for extra in grid:
+            f1, rule = _choose(
+                clone(detector).set_params(**extra),
+                Xtr,
+                [aps[i] for i in train],
+                gestures[train],
+                people[train],
+            )
+            found.append((f1, {**extra, **rule}))
+        cv_f1, rule = max(found, key=lambda pair: pair[0])
         detector.set_params(**rule)
         detector.fit(Xtr, gestures[train], action_points=[aps[i] for i in train])
         fit_s = time.perf_counter() - start
@@ -182,7 +218,7 @@ def detection(quick, step=2, window=30):
         stream = detector.stream()  # the stream gives the batch's events (one take checked)
         streamed = [e for frame in Xte[0] for e in stream.update(frame)]
         same = [(e.frame, e.label) for e in streamed] == [(e.frame, e.label) for e in events[0]]
-        per_call, median_call, batched = _cost_per_frame(detector, Xte[0][:300])
+        per_call, median_call, cpu, batched = _cost_per_frame(detector, Xte[0][:300])
         for latency in LATENCIES:
             for early_name, early in (("+-", None), ("after only", 0)):
                 frames = int(round(latency * RATE))
@@ -201,10 +237,12 @@ def detection(quick, step=2, window=30):
                         "trigger (CV)": rule["trigger"],
                         "threshold (CV)": rule["threshold"],
                         "refractory frames (CV)": rule["refractory"],
+                        "C (CV)": rule.get("C", ""),
                         "CV F1 at 0.5 s": cv_f1,
                         "stream events = batch": same,
                         "us per frame, one per call": per_call,
                         "us per call, median": median_call,
+                        "CPU us per frame, one per call": cpu,
                         "us per frame, batched": batched,
                         "fit + CV s": fit_s,
                     }
@@ -251,7 +289,7 @@ def figure(detectors, take, points, gesture, path):
         ax.set_ylabel("probability")
         ax.set_title(f"{name} (trigger {detector.trigger!r})", fontsize=9)
     ax.set_xlabel("time (s)")
-    np.atleast_1d(axes)[0].legend(loc="lower left", fontsize=7, ncol=5)
+    np.atleast_1d(axes)[0].legend(loc="upper right", fontsize=7, ncol=3)
     fig.tight_layout()
     path.parent.mkdir(exist_ok=True)
     fig.savefig(path, dpi=100)

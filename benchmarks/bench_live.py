@@ -594,6 +594,12 @@ def main():
         help="with the stream study: a folder holding an older built skmotion whose "
         "single-frame cost is measured in alternation with this one (live_stream_baseline)",
     )
+    parser.add_argument(
+        "--detectors",
+        nargs="*",
+        help="with the detection study: the detectors to run, by part of their name "
+        "(e.g. Linear MiniRocket; default: all)",
+    )
     parser.add_argument("--single-frame-worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.single_frame_worker:
@@ -634,7 +640,9 @@ def main():
         "within the latency before or after the action point, 'after only': at or after it."
     )
     if "detection" in only:
-        write_results("live_detection", detection(args.quick), notes=msrc_note)
+        write_results(
+            "live_detection", detection(args.quick, chosen=args.detectors), notes=msrc_note
+        )
     if "labelling" in only:
         write_results("live_labelling", labelling(args.quick), notes=msrc_note)
     if "decoder" in only:

@@ -16,7 +16,7 @@ from skmotion.control import KMeansPrimitiveController
 from skmotion.datasets import humanoid_skeleton, make_motions, make_walks
 from skmotion.decomposition import EigenMovementPCA, SVDFeatureExtractor
 from skmotion.io import as_motions
-from skmotion.live import ActivitySegmenter, GestureDetector
+from skmotion.live import ActivitySegmenter, GestureDetector, LinearGestureDetector
 from skmotion.neighbors import IntervalIndexNeighbors, MotionMatcher
 from skmotion.preprocessing import (
     FillGaps,
@@ -131,6 +131,11 @@ CASES = {
     "ToAeon": (ToAeon(), _motions, {}),
     "GestureDetector": (
         GestureDetector(window=8, random_state=0),
+        _motions,
+        {"scores": lambda est, X: [proba for _, proba in est.scores(X)]},
+    ),
+    "LinearGestureDetector": (
+        LinearGestureDetector(n_segments=2, segment=3, random_state=0),
         _motions,
         {"scores": lambda est, X: [proba for _, proba in est.scores(X)]},
     ),

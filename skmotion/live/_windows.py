@@ -8,7 +8,13 @@ detector has seen when frame ``t`` arrives.
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-__all__ = ["evaluation_ends", "labels_per_take", "take_windows", "training_windows"]
+__all__ = [
+    "evaluation_ends",
+    "labels_per_take",
+    "take_windows",
+    "training_ends",
+    "training_windows",
+]
 
 
 def evaluation_ends(n_frames, window, step):
@@ -48,8 +54,13 @@ def take_windows(take, ends, window):
     return [views[t - window + 1].T for t in ends]
 
 
-def training_windows(takes, action_points, labels, *, window, none_label, n_negatives, gap, rng):
-    """Windows ending at action points (their gesture) and ending elsewhere (``none_label``).
+def training_ends(takes, action_points, labels, *, window, none_label, n_negatives, gap, rng):
+    """Per take, the frames its training windows end at and their labels.
+
+    Windows end at the action points (labelled with their gesture) and at
+    ``n_negatives`` frames drawn from those more than ``gap`` frames from
+    every action point (labelled ``none_label``; fewer when the take has fewer
+    places). Only ends of full windows (from frame ``window - 1``) are kept.
 
     Parameters
     ----------
@@ -61,26 +72,46 @@ def training_windows(takes, action_points, labels, *, window, none_label, n_nega
     window : int
     none_label : str
     n_negatives : int
-        Negative windows drawn per take (fewer when the take has fewer places).
     gap : int
-        A negative window ends more than ``gap`` frames from every action point.
     rng : numpy.random.Generator
+
+    Returns
+    -------
+    ends : list of ndarray of int
+    y : list of ndarray of object
+    """
+    all_ends, all_y = [], []
+    for take, points, names in zip(takes, action_points, labels):
+        keep = (points >= window - 1) & (points < len(take))
+        ends = np.arange(window - 1, len(take))
+        if len(points) and len(ends):
+            distance = np.abs(ends[:, None] - points[None, :]).min(axis=1)
+            ends = ends[distance > gap]
+        chosen = np.sort(rng.choice(ends, size=min(n_negatives, len(ends)), replace=False))
+        all_ends.append(np.r_[points[keep], chosen].astype(np.intp))
+        all_y.append(np.r_[np.asarray(names, dtype=object)[keep], [none_label] * len(chosen)])
+    return all_ends, [np.asarray(y, dtype=object) for y in all_y]
+
+
+def training_windows(takes, action_points, labels, *, window, none_label, n_negatives, gap, rng):
+    """Windows ending at action points (their gesture) and ending elsewhere (``none_label``).
+
+    The windows of :func:`training_ends`, as arrays of shape (window, n_channels).
 
     Returns
     -------
     windows : list of ndarray of shape (window, n_channels)
     y : ndarray of object
     """
-    windows, y = [], []
-    for take, points, names in zip(takes, action_points, labels):
-        keep = (points >= window - 1) & (points < len(take))
-        windows += take_windows(take, points[keep], window)
-        y += list(names[keep])
-        ends = np.arange(window - 1, len(take))
-        if len(points) and len(ends):
-            distance = np.abs(ends[:, None] - points[None, :]).min(axis=1)
-            ends = ends[distance > gap]
-        chosen = np.sort(rng.choice(ends, size=min(n_negatives, len(ends)), replace=False))
-        windows += take_windows(take, chosen, window)
-        y += [none_label] * len(chosen)
-    return windows, np.asarray(y, dtype=object)
+    ends, y = training_ends(
+        takes,
+        action_points,
+        labels,
+        window=window,
+        none_label=none_label,
+        n_negatives=n_negatives,
+        gap=gap,
+        rng=rng,
+    )
+    windows = [w for take, e in zip(takes, ends) for w in take_windows(take, e, window)]
+    return windows, np.concatenate(y) if y else np.zeros(0, dtype=object)

@@ -1,0 +1,443 @@
+"""LinearGestureDetector: segment means of frame features and a linear readout, frame by frame."""
+
+from numbers import Integral, Real
+
+import numpy as np
+from sklearn.base import BaseEstimator
+from sklearn.linear_model import LogisticRegression
+from sklearn.preprocessing import StandardScaler
+from sklearn.utils import check_random_state
+from sklearn.utils.validation import check_is_fitted
+
+from skmotion.base import ClipEstimatorMixin, MotionTags
+from skmotion.live._detector import _check_points, _labels_per_point
+from skmotion.live._events import TRIGGERS, TriggerState, next_events
+from skmotion.live._window_kernel import frame_features, window_scores
+from skmotion.live._windows import training_ends
+from skmotion.utils._clips import check_clips
+from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
+
+__all__ = ["LinearGestureDetector", "LinearDetectorStream", "segment_means"]
+
+
+def segment_means(features, ends, n_segments, segment):
+    """Per window ending at ``ends``: the mean feature of each of its segments, side by side.
+
+    Segment ``k`` of the window ending at ``t`` holds frames
+    ``t - window + 1 + k * segment`` to ``t - window + (k + 1) * segment``,
+    ``window = n_segments * segment`` (one cumulative sum, no loop over frames).
+
+    Returns
+    -------
+    means : ndarray of shape (len(ends), n_segments * n_features)
+    """
+    total = np.vstack([np.zeros((1, features.shape[1])), np.cumsum(features, axis=0)])
+    first = np.asarray(ends) - n_segments * segment + 1
+    return np.hstack(
+        [
+            (total[first + (k + 1) * segment] - total[first + k * segment]) / segment
+            for k in range(n_segments)
+        ]
+    )
+
+
+class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
+    """Detect motions in a stream at a few microseconds per frame: segment means, a linear readout.
+
+    The window of the last ``n_segments * segment`` frames is described by the
+    mean *frame feature* of each of its ``n_segments`` consecutive segments
+    (in order: the start of a motion, its middle, its end), and a multinomial
+    logistic regression scores it against the rejection class ``none_label``.
+    It is trained, as :class:`GestureDetector`, on windows ending at action
+    points (and ``jitter`` frames around them) against windows ending
+    elsewhere. A frame feature is the frame's joints relative to the ``root``
+    joint, divided by the distance between the two ``size_joints`` (the
+    body's size; people and their distance to the sensor differ), and the
+    change of that from the previous frame.
+
+    Because the readout is linear in the segment means, a window's score is a
+    sum over its frames of one weight row per frame and segment: each new
+    frame is featurised once and its rows enter a ring of the last window's
+    frames, from which the window's score is summed, in a compiled loop. A
+    window is scored at every frame for a few microseconds, in constant
+    memory; the batch :meth:`scores` run the same loop, so stream and batch
+    agree to the last bit. The events come from the decision rule of
+    :class:`GestureDetector` (``trigger``, ``threshold``, ``refractory``).
+
+    Parameters
+    ----------
+    n_segments : int, default=5
+        Segments per window.
+    segment : int, default=6
+        Frames per segment (the window: ``n_segments * segment`` frames, 2 s at 15 frames/s).
+    root : int, default=None
+        The joint whose position is subtracted from every joint (channels
+        ``3 * root`` to ``3 * root + 2``); None: channels as they are.
+        Needs channels in joint order, three per joint.
+    size_joints : (int, int), default=None
+        Two joints whose distance divides the positions; None: no division.
+    C : float, default=0.1
+        Inverse regularisation of the logistic regression (on standardised segment means).
+    threshold : float, default=0.5
+        The probability of the best motion that starts (``"rise"``) or whose
+        loss ends (``"fall"``) an event.
+    refractory : int, default=15
+        The fewest frames between two events.
+    trigger : {"fall", "rise"}, default="fall"
+        As for :class:`GestureDetector`.
+    jitter : int, default=1
+        Positive windows also end this many frames before and after each action point.
+    n_negatives : int, default=40
+        Windows ending away from action points drawn per training take.
+    negative_gap : int, default=3
+        A negative window ends more than this many frames from every action point.
+    none_label : str, default="none"
+        The rejection class.
+    random_state : int, RandomState instance or None, default=None
+        Draws the negative windows.
+
+    Attributes
+    ----------
+    classifier_ : LogisticRegression
+        The readout, on standardised segment means.
+    mean_, scale_ : ndarray of shape (n_segments * 2 * n_features_in_,)
+        The standardisation of the segment means.
+    weights_ : ndarray of shape (n_segments, 2 * n_features_in_, n_classes)
+        The readout per frame and segment: a frame feature times
+        ``weights_[k]`` is that frame's part of the decision when it lies in segment ``k``.
+    bias_ : ndarray of shape (n_classes,)
+    classes_ : ndarray
+        The classes, ``none_label`` among them.
+    none_index_ : int
+        The column of ``none_label`` in ``classes_``.
+    n_features_in_ : int
+        Channels per frame.
+
+    See Also
+    --------
+    GestureDetector : the same events from any clip recogniser.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.live import LinearGestureDetector
+    >>> rng = np.random.default_rng(0)
+    >>> take = rng.normal(0, 0.05, (400, 2))
+    >>> points = np.arange(49, 400, 70)                  # a repetition completes at 49, 119, ...
+    >>> for end in points:                               # a rise over 20 frames, then a drop
+    ...     take[end - 19 : end + 1] += np.linspace(0, 1, 20)[:, None]
+    >>> detector = LinearGestureDetector(segment=4, random_state=0)
+    >>> detector = detector.fit([take], ["rise"], action_points=[points])
+    >>> # trigger="fall": a few frames after each completion, as the score drops
+    >>> [event.frame for event in detector.detect([take])[0]]
+    [54, 124, 194, 264, 334]
+    >>> stream = detector.stream()                       # the same, one frame at a time
+    >>> [event.frame for frame in take for event in stream.update(frame)]
+    [54, 124, 194, 264, 334]
+    """
+
+    _parameter_constraints = {
+        "n_segments": [Interval(Integral, 1, None, closed="left")],
+        "segment": [Interval(Integral, 1, None, closed="left")],
+        "root": [Interval(Integral, 0, None, closed="left"), None],
+        "size_joints": [tuple, list, None],
+        "C": [Interval(Real, 0, None, closed="neither")],
+        "threshold": [Interval(Real, 0, 1, closed="both")],
+        "refractory": [Interval(Integral, 0, None, closed="left")],
+        "trigger": [StrOptions(set(TRIGGERS))],
+        "jitter": [Interval(Integral, 0, None, closed="left")],
+        "n_negatives": [Interval(Integral, 0, None, closed="left")],
+        "negative_gap": [Interval(Integral, 0, None, closed="left")],
+        "none_label": [str],
+        "random_state": ["random_state"],
+    }
+    _motion_tags = MotionTags(output_kind="segments")
+
+    def __init__(
+        self,
+        *,
+        n_segments=5,
+        segment=6,
+        root=None,
+        size_joints=None,
+        C=0.1,
+        threshold=0.5,
+        refractory=15,
+        trigger="fall",
+        jitter=1,
+        n_negatives=40,
+        negative_gap=3,
+        none_label="none",
+        random_state=None,
+    ):
+        self.n_segments = n_segments
+        self.segment = segment
+        self.root = root
+        self.size_joints = size_joints
+        self.C = C
+        self.threshold = threshold
+        self.refractory = refractory
+        self.trigger = trigger
+        self.jitter = jitter
+        self.n_negatives = n_negatives
+        self.negative_gap = negative_gap
+        self.none_label = none_label
+        self.random_state = random_state
+
+    @property
+    def window(self):
+        """Frames per window: ``n_segments * segment``."""
+        return self.n_segments * self.segment
+
+    def _joints(self):
+        """``(root, size_a, size_b)`` for the kernel, -1 for none; checked against the channels."""
+        n_joints = self.n_features_in_ // 3
+        joints = [-1 if self.root is None else self.root]
+        if self.size_joints is not None:
+            if len(self.size_joints) != 2:
+                raise ValueError(f"size_joints: two joints are needed, got {self.size_joints!r}.")
+            joints += [int(j) for j in self.size_joints]
+            if min(joints[1:]) < 0:
+                raise ValueError(f"size_joints: joint indices are >= 0, got {self.size_joints!r}.")
+        else:
+            joints += [-1, -1]
+        used = [j for j in joints if j >= 0]
+        if used and (self.n_features_in_ % 3 or max(used) >= n_joints):
+            raise ValueError(
+                f"root={self.root}, size_joints={self.size_joints}: joints need three channels "
+                f"each; the frames have {self.n_features_in_} channels ({n_joints} joints)."
+            )
+        return tuple(joints)
+
+    def _features(self, take):
+        return frame_features(np.ascontiguousarray(take, dtype=float), *self._joints())
+
+    @_fit_context(prefer_skip_nested_validation=False)
+    def fit(self, X, y, *, action_points=None):
+        """Train the readout on windows ending at action points (± ``jitter``) and elsewhere.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+            Long takes, each holding repetitions of motions.
+        y : array-like of shape (n_takes,)
+            The motion of each take, or per take an array with the motion of
+            each of its action points.
+        action_points : list of array-like of int, default=None
+            Per take, the frames at which a repetition is complete. None: each
+            take is one repetition, complete at its last frame.
+
+        Returns
+        -------
+        self : LinearGestureDetector
+            The fitted detector.
+        """
+        clips = check_clips(X, estimator=self, reset=True)
+        if len(y) != len(clips):
+            raise ValueError(f"y: {len(y)} labels for {len(clips)} takes.")
+        points = _check_points(action_points, clips)
+        labels = _labels_per_point(y, points)
+        if any(self.none_label in set(names) for names in labels):
+            raise ValueError(f"y: the rejection class {self.none_label!r} labels an action point.")
+        self._joints()
+        # each positive window also ends up to `jitter` frames from its action point
+        shifts = np.arange(-self.jitter, self.jitter + 1)
+        moved = [np.clip(p[:, None] + shifts, 0, len(c) - 1).ravel() for p, c in zip(points, clips)]
+        moved_labels = [np.repeat(n, len(shifts)) for n in labels]
+        rng = np.random.default_rng(check_random_state(self.random_state).randint(2**31))
+        ends, targets = training_ends(
+            clips,
+            moved,
+            moved_labels,
+            window=self.window,
+            none_label=self.none_label,
+            n_negatives=self.n_negatives,
+            gap=self.negative_gap + self.jitter,
+            rng=rng,
+        )
+        if len(set(np.concatenate(targets)) - {self.none_label}) == 0:
+            raise ValueError(
+                f"no action point ends a full window of {self.window} frames: shorten the window."
+            )
+        means = np.vstack(
+            [
+                segment_means(self._features(c), e, self.n_segments, self.segment)
+                for c, e in zip(clips, ends)
+            ]
+        )
+        # StandardScaler leaves constant columns (up to rounding: a root joint) unscaled
+        scaler = StandardScaler().fit(means)
+        self.mean_, self.scale_ = scaler.mean_, scaler.scale_
+        classifier = LogisticRegression(C=self.C, max_iter=3000)
+        self.classifier_ = classifier.fit(
+            (means - self.mean_) / self.scale_, np.concatenate(targets)
+        )
+        self.classes_ = classifier.classes_
+        found = np.flatnonzero(self.classes_ == self.none_label)
+        if not len(found):
+            raise ValueError(
+                f"no window of the rejection class {self.none_label!r}: raise n_negatives."
+            )
+        self.none_index_ = int(found[0])
+        coef, intercept = classifier.coef_, classifier.intercept_
+        if len(self.classes_) == 2:  # binary: predict_proba is the softmax of (0, decision)
+            coef, intercept = np.vstack([np.zeros_like(coef), coef]), np.r_[0.0, intercept]
+        coef = coef / self.scale_
+        self.bias_ = intercept - coef @ self.mean_
+        n_features = 2 * self.n_features_in_
+        self.weights_ = np.ascontiguousarray(
+            (coef / self.segment).T.reshape(self.n_segments, n_features, len(self.classes_))
+        )
+        return self
+
+    def stream(self):
+        """A stream fed frame by frame, emitting the events of :meth:`detect`.
+
+        Returns
+        -------
+        stream : LinearDetectorStream
+        """
+        check_is_fitted(self)
+        return LinearDetectorStream(self)
+
+    def scores(self, X):
+        """The scored frames of each take and the class probabilities of their windows.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        scores : list of (ndarray of int, ndarray of shape (n_windows_i, n_classes))
+            Per take, the frame each window ends at (every frame from
+            ``window - 1``) and its probabilities (columns in the order of ``classes_``).
+        """
+        check_is_fitted(self)
+        out = []
+        for take in check_clips(X, estimator=self):
+            proba, _, _ = self.stream()._score(np.ascontiguousarray(take, dtype=float))
+            ends = np.arange(self.window - 1, len(take), dtype=np.intp)
+            out.append((ends, proba[self.window - 1 :]))
+        return out
+
+    def detect(self, X):
+        """The events of each take, as the stream would emit them.
+
+        Parameters
+        ----------
+        X : list of ndarray of shape (n_frames_i, n_channels)
+
+        Returns
+        -------
+        events : list of list of Event
+            Per take, its events ``(frame, label, score)`` in time order.
+        """
+        rule = dict(threshold=self.threshold, refractory=self.refractory, trigger=self.trigger)
+        return [
+            next_events(ends, proba, self.classes_, self.none_index_, state=TriggerState(), **rule)[
+                0
+            ]
+            for ends, proba in self.scores(X)
+        ]
+
+
+class LinearDetectorStream:
+    """The live side of :class:`LinearGestureDetector` (made by its ``stream()``).
+
+    Holds the last window's per-frame weight rows (``window x n_segments x
+    n_classes`` numbers), the last pose and the decision rule's state: its
+    memory does not grow with the stream. A frame whose best motion is below
+    the threshold while no run above it is open cannot emit (the decision
+    rule would return no event and the same state), so it costs the compiled
+    update alone.
+
+    Attributes
+    ----------
+    n_frames : int
+        Frames seen since the start (or the last :meth:`reset`).
+    last_proba : ndarray of shape (n_classes,)
+        The probabilities of the last full window (zeros before the first).
+    """
+
+    def __init__(self, detector):
+        d = detector
+        self._args = (d.weights_, d.bias_, *d._joints(), d.segment, d.none_index_)
+        self._classes, self._none = d.classes_, d.none_index_
+        self._rule = dict(threshold=d.threshold, refractory=d.refractory, trigger=d.trigger)
+        self._threshold, self._fall = d.threshold, d.trigger == "fall"
+        n_classes = len(d.classes_)
+        self._ring = np.zeros((d.window, d.n_segments, n_classes))
+        self._previous = np.zeros(d.n_features_in_)
+        self._feature = np.zeros(2 * d.n_features_in_)
+        self._one = (np.zeros((1, n_classes)), np.zeros(1), np.zeros(1, dtype=np.intp))
+        self.last_proba = self._one[0][0]
+        self.reset()
+
+    def reset(self):
+        """Forget every frame: the stream starts again."""
+        self.n_frames = 0
+        self._state = TriggerState()
+        self._ring[:] = 0.0
+        self.last_proba[:] = 0.0
+
+    def _score(self, frames, out=None):
+        """The compiled update over ``frames``: per frame, probabilities, best score and class."""
+        n = len(frames)
+        proba, score, best = out or (
+            np.zeros((n, len(self._classes))),
+            np.empty(n),
+            np.empty(n, np.intp),
+        )
+        bad = window_scores(
+            frames, self._previous, self._feature, self._ring, self.n_frames, *self._args,
+            proba, score, best,
+        )  # fmt: skip
+        if bad >= 0:
+            self.n_frames += bad
+            raise ValueError(f"update: frame {self.n_frames} holds NaN or infinity.")
+        self.n_frames += n
+        return proba, score, best
+
+    def update(self, frames):
+        """Add one frame (or a chunk of frames) and return the events they complete.
+
+        Parameters
+        ----------
+        frames : array-like of shape (n_channels,) or (n_frames, n_channels)
+
+        Returns
+        -------
+        events : list of Event
+            The events emitted at these frames (usually none).
+        """
+        frames = np.ascontiguousarray(frames, dtype=float)
+        width = len(self._previous)
+        if frames.shape == (width,):  # the one-frame path: no copies, one compiled call
+            proba, score, best = self._score(frames.reshape(1, width), self._one)
+            state, top = self._state, float(score[0])
+            # the two cases in which next_events would emit nothing, said in scalars
+            if state.run_best is None and top < self._threshold:
+                return []  # below the threshold and no run open: nothing changes
+            if self._fall and state.run_best is not None and top >= self._threshold:
+                if top > state.run_score:  # a run goes on: it keeps its best motion
+                    self._state = state._replace(run_best=best[0], run_score=top)
+                return []
+            start = self.n_frames - 1
+        else:
+            if frames.ndim != 2 or frames.shape[1] != width:
+                raise ValueError(
+                    f"update: frames must have {width} channels, got an array of shape "
+                    f"{frames.shape}."
+                )
+            if not len(frames):
+                return []
+            start = self.n_frames
+            proba, score, _ = self._score(frames)
+            self.last_proba[:] = proba[-1] if score[-1] >= 0 else self.last_proba
+        full = score >= 0
+        ends = np.arange(start, start + len(score))[full]
+        events, self._state = next_events(
+            ends, proba[full], self._classes, self._none, state=self._state, **self._rule
+        )
+        return events
