@@ -98,7 +98,8 @@ def _znorm_profile(query, take, n_threads):
     # Channel-major, each channel shifted to mean 0 in one pass: shifting changes
     # no z-normalised distance but shrinks the FFT's rounding, which grows with the
     # values' size; a contiguous channel is what the FFT and the compiled pass read.
-    channels = np.subtract(take.T, take.mean(axis=0)[:, None], order="C")
+    channels = np.ascontiguousarray(take.T)
+    channels -= channels.mean(axis=1, keepdims=True)
 
     def add_channels(which):
         total = np.zeros(len(take) - m + 1)
