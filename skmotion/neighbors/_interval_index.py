@@ -282,6 +282,9 @@ class IntervalIndex:
     def leaf_items(self, leaf):
         """Sorted ids of the items in a leaf, as an ``int32`` array."""
         parts = []
+        # The leaf as the blocks' own int32: searchsorted with an int64 key would
+        # first convert the whole block, work that grows with the collection.
+        leaf = np.int32(leaf)
         for leaves, offsets, items in self._blocks:
             at = np.searchsorted(leaves, leaf)
             if at < len(leaves) and leaves[at] == leaf:
@@ -296,7 +299,8 @@ class IntervalIndex:
 
     def _leaf_bounds(self, leaves):
         """The non-empty blocks, and per block where each leaf's items start and end."""
-        leaves = np.asarray(leaves)
+        # The blocks' own int32 (see leaf_items): no conversion of the blocks.
+        leaves = np.asarray(leaves).astype(np.int32)
         blocks = [block for block in self._blocks if len(block[0])]
         bounds = []
         for block_leaves, offsets, _ in blocks:

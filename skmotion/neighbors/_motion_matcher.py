@@ -18,6 +18,7 @@ approximately at recall@1 0.99 where hnswlib's graph of the same degree and
 construction beam reached 0.92; brute force stays available for checking.
 """
 
+import math
 from numbers import Integral, Real
 
 import numpy as np
@@ -291,6 +292,7 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
             self.index_ = BallTree(data, leaf_size=self.leaf_size)
         elif algorithm == "hnsw":
             self.index_ = _hnsw_index(data)
+            self._ef_set = None
         else:
             self.index_ = None
             self.squared_norms_ = np.einsum("ij,ij->i", data, data)
@@ -328,25 +330,37 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         distance : ndarray of shape (n_queries, n_neighbors)
             Euclidean, nearest first.
         """
-        if not hasattr(self, "features_"):
+        if "features_" not in vars(self):
             # check_is_fitted's scan of the attributes costs as much as an approximate query.
             check_is_fitted(self)
-        X = np.atleast_2d(np.asarray(X, dtype=float))
-        if X.shape[1] != self.features_.shape[1]:
+        X = np.asarray(X, dtype=float)
+        if X.ndim == 1:
+            X = X[None]
+        if X.ndim != 2 or X.shape[1] != self.features_.shape[1]:
             raise ValueError(
-                f"X has {X.shape[1]} features; the index has {self.features_.shape[1]}"
+                f"X has shape {X.shape}; the index needs (n_queries, {self.features_.shape[1]})"
             )
-        finite = np.isfinite(X).all(axis=1)
-        if not finite.all():
-            row = int(np.flatnonzero(~finite)[0])
-            raise ValueError(f"query {row} holds NaN or inf")
+        # One dot product is finite when every value is (and not too large): the
+        # row-wise check, many times the cost of the rest of the wrapper, runs only
+        # when it is not.
+        flat = X.reshape(-1)
+        with np.errstate(over="ignore", invalid="ignore"):
+            square = flat @ flat
+        if not math.isfinite(square):
+            finite = np.isfinite(X).all(axis=1)
+            if not finite.all():
+                raise ValueError(f"query {int(np.flatnonzero(~finite)[0])} holds NaN or inf")
         k = min(int(n_neighbors), len(self.features_))
-        if isinstance(self.index_, (KDTree, BallTree)):
-            distance, index = self.index_.query(X, k=k)
-        elif self.index_ is not None:
-            self.index_.hnsw.efSearch = max(self.ef, k)
-            squared, index = self.index_.search(X.astype(np.float32), k)
-            index, distance = index.astype(np.intp), np.sqrt(np.maximum(squared, 0.0))
+        index = self.index_
+        if isinstance(index, (KDTree, BallTree)):
+            distance, index = index.query(X, k=k)
+        elif index is not None:
+            ef = max(self.ef, k)
+            if ef != self._ef_set:
+                # A SWIG attribute write costs microseconds: only when it changes.
+                index.hnsw.efSearch = self._ef_set = ef
+            distance, found = _faiss_search(index, X, k)
+            index = found
         else:
             distance, index = _brute_force(self.features_, self.squared_norms_, X, k)
         return self.take_[index], self.frame_[index], distance
@@ -362,7 +376,7 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         index = state.get("index_")
         if isinstance(index, tuple) and index[0] == "faiss":
             buffer = np.frombuffer(index[1], dtype=np.uint8)
-            state = dict(state, index_=_faiss().deserialize_index(buffer))
+            state = dict(state, index_=_faiss().deserialize_index(buffer), _ef_set=None)
         super().__setstate__(state)
 
     def __sklearn_tags__(self):
@@ -381,6 +395,17 @@ def _brute_force(data, squared_norms, X, k):
     index = np.take_along_axis(part, order, axis=1)
     distance = np.sqrt(np.maximum(np.take_along_axis(squared, index, axis=1), 0.0))
     return distance, index
+
+
+def _faiss_search(index, X, k):
+    """faiss's search without its Python wrapper's checks (done above): distances, rows."""
+    faiss = _faiss()
+    X = np.ascontiguousarray(X, dtype=np.float32)
+    squared = np.empty((len(X), k), dtype=np.float32)
+    rows = np.empty((len(X), k), dtype=np.int64)
+    index.search_c(len(X), faiss.swig_ptr(X), k, faiss.swig_ptr(squared), faiss.swig_ptr(rows))
+    np.maximum(squared, 0.0, out=squared)
+    return np.sqrt(squared, out=squared), rows
 
 
 def _faiss():

@@ -21,10 +21,12 @@ chosen one in the same take (``"znorm"``), or no path overlapping a chosen
 one (``"dtw"``), and so on.
 """
 
+from concurrent.futures import ThreadPoolExecutor
 from numbers import Integral, Real
 
 import numpy as np
 import pandas as pd
+from joblib import effective_n_jobs
 from numpy.lib.stride_tricks import as_strided
 from scipy import fft
 
@@ -86,19 +88,34 @@ def sliding_dots(query, series, block=None, workers=None):
     return dots.reshape(-1)[:n_windows]
 
 
-def _znorm_profile(query, take, workers):
-    """Mean over channels of the z-normalised distance of each window to the query."""
+def _znorm_profile(query, take, n_threads):
+    """Mean over channels of the z-normalised distance of each window to the query.
+
+    With several threads, each handles whole channels: the FFTs and the
+    compiled pass release the GIL, and a channel's work is independent.
+    """
     m, n_channels = query.shape
-    total = np.zeros(len(take) - m + 1)
-    for c in range(n_channels):
-        # Shifting a channel changes no z-normalised distance but shrinks the
-        # FFT's rounding, which grows with the values' size.
-        x = take[:, c] - take[:, c].mean()
-        q = query[:, c]
-        constant = bool(np.all(q == q[0]))
-        dots = total if constant else sliding_dots((q - q.mean()) / q.std(), x, workers=workers)
-        _loops.add_znorm_distance(x, dots, m, constant, total)
-    return total / n_channels
+    # Channel-major, each channel shifted to mean 0 in one pass: shifting changes
+    # no z-normalised distance but shrinks the FFT's rounding, which grows with the
+    # values' size; a contiguous channel is what the FFT and the compiled pass read.
+    channels = np.ascontiguousarray(take.T)
+    channels -= channels.mean(axis=1, keepdims=True)
+
+    def add_channels(which):
+        total = np.zeros(len(take) - m + 1)
+        for c in which:
+            q = query[:, c]
+            constant = bool(np.all(q == q[0]))
+            dots = total if constant else sliding_dots((q - q.mean()) / q.std(), channels[c])
+            _loops.add_znorm_distance(channels[c], dots, m, constant, total)
+        return total
+
+    n_threads = min(n_threads, n_channels)
+    if n_threads <= 1:
+        return add_channels(range(n_channels)) / n_channels
+    with ThreadPoolExecutor(n_threads) as pool:
+        parts = list(pool.map(add_channels, np.array_split(np.arange(n_channels), n_threads)))
+    return sum(parts) / n_channels
 
 
 def _dtw_profile(query, take):
@@ -182,7 +199,8 @@ def find_occurrences(
     max_distance : float, default=inf
         Occurrences farther than this are not returned.
     n_jobs : int, default=None
-        Threads of the FFTs (``"znorm"``); None is one, -1 all cores.
+        Threads (``"znorm"``), each handling whole channels; None is one, -1
+        all cores.
 
     Returns
     -------
@@ -221,7 +239,7 @@ def find_occurrences(
         if array.shape[1] != n_channels:
             raise ValueError(f"take {i} has {array.shape[1]} channels and the query {n_channels}")
         arrays.append(array)
-    workers = 1 if n_jobs is None else n_jobs
+    n_threads = effective_n_jobs(n_jobs)
     if metric == "znorm":
         exclusion = int(np.ceil(m / 4)) if exclusion is None else exclusion
     else:
@@ -229,7 +247,7 @@ def find_occurrences(
     profiles, starts = [], []
     for take in arrays:
         if metric == "znorm":
-            profile = _znorm_profile(query, take, workers) if len(take) >= m else np.empty(0)
+            profile = _znorm_profile(query, take, n_threads) if len(take) >= m else np.empty(0)
             start = np.arange(len(profile))
         else:
             profile, start = _dtw_profile(query, take)

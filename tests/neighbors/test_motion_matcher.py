@@ -125,6 +125,32 @@ def test_hnsw_recall_and_pickle(walks):
     )
 
 
+def test_hnsw_follows_ef_changes_after_fit(walks):
+    pytest.importorskip("faiss")
+    takes, new = walks
+    exact = MotionMatcher().fit(takes)
+    approx = MotionMatcher(algorithm="hnsw", ef=1).fit(takes)
+    queries = np.concatenate(exact.frame_features(new))[::5]
+    truth = exact.kneighbors(queries)[2][:, 0]
+    approx.kneighbors(queries)
+    # A beam as wide as the collection visits every reachable frame: exact.
+    approx.set_params(ef=len(approx.features_))
+    np.testing.assert_allclose(approx.kneighbors(queries)[2][:, 0], truth, rtol=1e-5, atol=1e-5)
+
+
+def test_huge_finite_queries_are_not_refused(walks):
+    # The fast finiteness check (one dot product) overflows for these values: the
+    # row-wise check behind it must accept them, and still name a NaN row.
+    takes, _ = walks
+    matcher = MotionMatcher(algorithm="brute").fit(takes)
+    huge = np.full((2, matcher.features_.shape[1]), 1e200)
+    take, frame, _ = matcher.kneighbors(huge)
+    assert take.shape == frame.shape == (2, 1)
+    huge[1, 3] = np.nan
+    with pytest.raises(ValueError, match="query 1 holds NaN"):
+        matcher.kneighbors(huge)
+
+
 def test_weights_scale_the_groups(walks):
     takes, _ = walks
     base = MotionMatcher().fit(takes)

@@ -144,3 +144,17 @@ def test_bad_input_is_named(rng):
         find_occurrences(take[:10], [rng.normal(size=(50, 3))])
     with pytest.raises(ValueError, match="2 frames or more"):
         find_occurrences(take[:1], [take])
+
+
+def test_threads_split_the_channels_and_agree_with_one(rng):
+    # Five channels over two threads: 3 + 2, each thread summing its own; the
+    # reference is the explicit z-normalisation of every window.
+    take = np.cumsum(rng.normal(size=(400, 5)), axis=0)
+    query = take[150:170] + rng.normal(scale=0.05, size=(20, 5))
+    one = find_occurrences(query, [take], n_occurrences=4)
+    two = find_occurrences(query, [take], n_occurrences=4, n_jobs=2)
+    assert two.start.tolist() == one.start.tolist()
+    np.testing.assert_allclose(two.distance, one.distance, atol=1e-9)
+    profile = _znorm_reference(query, take)
+    assert one.start[0] == int(np.argmin(profile)) == 150
+    np.testing.assert_allclose(one.distance[0], profile.min(), atol=1e-9)

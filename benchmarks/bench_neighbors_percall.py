@@ -1,0 +1,84 @@
+"""IntervalIndexNeighbors: one query per call against the batched cost per query.
+
+Euclidean feature vectors (clusters of 20 with a label each, 10 components),
+``--sizes`` stored vectors; 300 queries from the same clusters. Per query, the
+process's CPU time of ``kneighbors`` on the whole batch and one query per call,
+and their ratio (the issue's target: at most 2), beside sklearn's ball tree on
+the same vectors, one query per call. A single query used to cost time that
+grew with the collection: ``searchsorted`` on a leaf block with an int64 key
+converts the whole int32 block first.
+
+Run: ``python benchmarks/bench_neighbors_percall.py --sizes 10000,100000``.
+"""
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from sklearn.neighbors import NearestNeighbors
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _common import write_results  # noqa: E402
+
+from skmotion.neighbors import IntervalIndexNeighbors  # noqa: E402
+
+
+def _clusters(n, n_queries, seed=0):
+    rng = np.random.default_rng(seed)
+    centers = rng.normal(size=(max(n // 20, 1), 10)) * 3
+    y = rng.integers(0, len(centers), n)
+    yq = rng.integers(0, len(centers), n_queries)
+    noise = rng.normal(scale=0.3, size=(n + n_queries, 10))
+    return centers[y] + noise[:n], y, centers[yq] + noise[n:]
+
+
+def _cpu_us(func, queries, one_per_call):
+    start = time.process_time()
+    if one_per_call:
+        out = np.concatenate([func(q[None]) for q in queries])
+    else:
+        out = func(queries)
+    return (time.process_time() - start) / len(queries) * 1e6, out
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", default="10000,100000")
+    parser.add_argument("--queries", type=int, default=300)
+    args = parser.parse_args()
+    load = os.getloadavg()
+    rows = []
+    for n in map(int, args.sizes.split(",")):
+        X, y, Q = _clusters(n, args.queries)
+        start = time.perf_counter()
+        index = IntervalIndexNeighbors(random_state=0).fit(X, y)
+        fit_s = time.perf_counter() - start
+        ball = NearestNeighbors(n_neighbors=1, algorithm="ball_tree").fit(X)
+        ours = lambda q: index.kneighbors(q, 1, return_distance=False)[:, 0]  # noqa: E731
+        theirs = lambda q: ball.kneighbors(q, return_distance=False)[:, 0]  # noqa: E731
+        ours(Q[:5])
+        batched, a = _cpu_us(ours, Q, False)
+        single, b = _cpu_us(ours, Q, True)
+        ball_single, _ = _cpu_us(theirs, Q, True)
+        rows.append(
+            {
+                "stored": n,
+                "fit_s": round(fit_s, 1),
+                "mean_candidates": round(float(np.mean([len(c) for c in index.candidates(Q)])), 1),
+                "batched_cpu_us_per_query": round(batched, 1),
+                "one_per_call_cpu_us": round(single, 1),
+                "one_per_call_over_batched": round(single / batched, 2),
+                "same_answers": bool(np.array_equal(a, b)),
+                "ball_tree_one_per_call_cpu_us": round(ball_single, 1),
+            }
+        )
+        print(rows[-1], flush=True)
+    notes = f"load average at the start: {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f}"
+    write_results("neighbors_percall", rows, notes=notes)
+
+
+if __name__ == "__main__":
+    main()
