@@ -353,15 +353,16 @@ def run_case(source, path, mutated, description, kind, original, counts, failure
     return outcome
 
 
-def fuzz_reader(reader, shared, folder, *, n_cases, seed, time_limit=5.0):
+def fuzz_reader(reader, shared, folder, *, n_cases, seed, chunk=0, time_limit=5.0):
     """Mutate the real files of ``reader`` ``n_cases`` times in all (round robin).
 
-    Returns ``(counts per source, failures)``; each failure is (source, outcome,
-    description, mutated bytes).
+    ``chunk`` selects an independent random stream, so that one budget can be split
+    over processes and stay reproducible. Returns ``(counts per source, failures)``;
+    each failure is (source, outcome, description, mutated bytes).
     """
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
-    rng = np.random.default_rng([seed, READERS.index(reader)])
+    rng = np.random.default_rng([seed, READERS.index(reader), chunk])
     chosen = sources(reader, shared, folder)
     originals, counts, failures = [], {}, []
     for source in chosen:
