@@ -84,3 +84,26 @@ def test_a_column_named_for_another_axis_is_refused(tmp_path):
     motion = read_keypoints(_keypoint_text(tmp_path, ok), columns="xyzc", frame_rate=30)
     np.testing.assert_array_equal(motion.channels, [[0.5, 1, 2]])
     assert motion.extras["confidence"].tolist() == [[0.9]]
+
+
+@pytest.mark.parametrize("units", ["", "furlongs"])
+def test_a_c3d_parameter_error_comes_before_the_positions_are_decoded(tmp_path, rng, units):
+    """Found by the run: a Plug-in Gait file whose POINT:UNITS byte was zeroed decoded every
+    position (3.4x the file's size) before refusing the unit. The parameters are now
+    checked first: the refusal costs a fraction of the file's size."""
+    import tracemalloc
+
+    from skmotion.io import read_c3d
+    from tests.io.c3d_files import c3d_bytes
+
+    path = tmp_path / "trial.c3d"
+    path.write_bytes(c3d_bytes(rng.normal(size=(2000, 60, 3)), units=units))
+    size = path.stat().st_size
+    tracemalloc.start()
+    try:
+        with pytest.raises(MotionFileError, match=r"trial\.c3d: POINT:UNITS"):
+            read_c3d(path)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 1.5 * size, (peak, size)  # the file's bytes and the parameters only
