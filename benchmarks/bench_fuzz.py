@@ -14,20 +14,33 @@ source: rejected, agrees (equal to an independent reference), read as the edited
 states (no independent truth), crashes outside the library's errors, hangs, peak
 allocations past 2x the file's size (plus 1 MB), silent wrong reads (all four must be 0).
 
+Part 2b (``--per-reader``, ``bench_fuzz_readers``) runs ``tests/bad_input/reader_fuzz.py``:
+mutations of the real files only, counted per reader (C3D, BVH, ASF, AMC, keypoints),
+the issue's budget being 10,000 per reader. The budget is split in jobs of 1,000 cases
+over ``--workers`` processes (default 2, one per core), each with its address space
+capped (``resource.setrlimit``) so that a forged size fails as a MemoryError (a crash)
+instead of taking the shared machine down; every case has its own time limit
+(``signal.setitimer``) and allocation tracing (``tracemalloc``). Failing cases are
+written to ``results/fuzz_failures/`` for regression tests, and each job's counts to
+``results/fuzz_jobs/``: ``--collect`` makes the table of a run cut short.
+
 Part 3 writes a large BVH file (``--mb``, default 20; the issue's figure is 100) and
 reads it valid and with one error near its end (a word, ``1_000``, a short frame line,
 missing frames, a NUL byte), each in a fresh process, recording seconds and peak
 memory: the error path should cost about what the valid path does.
 
     python benchmarks/bench_fuzz.py                  # 1,500 (binary: 2,500) cases per source
-    python benchmarks/bench_fuzz.py --binary-cases 10000 --cases 0 --mb 0   # the issue's budget
+    python benchmarks/bench_fuzz.py --per-reader 10000 --binary-cases 0 --cases 0 --mb 0
+                                                     # the issue's budget: real files per reader
     python benchmarks/bench_fuzz.py --cases 200 --mb 5   # quick
     python benchmarks/bench_fuzz.py --mb 100         # the issue's size
 """
 
 import argparse
 import json
+import multiprocessing
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -36,7 +49,7 @@ from pathlib import Path
 
 from _common import SHARED_DATA, write_results
 
-from tests.bad_input import binary_fuzz, fuzz
+from tests.bad_input import binary_fuzz, fuzz, reader_fuzz
 from tests.bad_input.long_inputs import write_long_bvh
 
 _READ = """
@@ -159,6 +172,97 @@ def binary_counts(n_cases, seed):
     return tally
 
 
+_MEMORY_CAP = 4 << 30  # bytes of address space per worker
+_CHUNK = 1000  # cases per job: a reader's budget is split over the workers
+_JOBS = Path(__file__).parent / "results" / "fuzz_jobs"
+
+
+def _fuzz_one_chunk(job):
+    """One job; its counts and failures are also saved, so a run cut short keeps them."""
+    reader, n_cases, seed, chunk = job
+    resource.setrlimit(resource.RLIMIT_AS, (_MEMORY_CAP, _MEMORY_CAP))
+    with tempfile.TemporaryDirectory() as folder:
+        counts, failures = reader_fuzz.fuzz_reader(
+            reader, _shared_data(), folder, n_cases=n_cases, seed=seed, chunk=chunk
+        )
+    saved = _JOBS.parent / "fuzz_failures"
+    for k, (source, _, _, data) in enumerate(failures):
+        saved.mkdir(parents=True, exist_ok=True)
+        (saved / f"{reader}-{chunk}-{k}-{source}").write_bytes(data)
+    failures = [f"{reader} {s}: {o}: {d}" for s, o, d, _ in failures]
+    _JOBS.mkdir(parents=True, exist_ok=True)
+    job_file = _JOBS / f"{seed}-{reader}-{chunk}.json"
+    job_file.write_text(json.dumps({"counts": counts, "failures": failures}))
+    return reader, counts, failures
+
+
+def _table(results):
+    """Rows per reader (all, then per file) from (reader, counts, failures) of the jobs."""
+    totals = {reader: {} for reader in reader_fuzz.READERS}
+    for reader, counts, _ in results:
+        for name, row in counts.items():
+            total = totals[reader].setdefault(name, dict.fromkeys(reader_fuzz.OUTCOMES, 0))
+            for key, value in row.items():
+                total[key] += value
+    rows = []
+    for reader in reader_fuzz.READERS:
+        counts = totals[reader]
+        total = {k: sum(row[k] for row in counts.values()) for k in reader_fuzz.OUTCOMES}
+        rows.append({"reader": reader, "file": "all", **total})
+        rows += [{"reader": reader, "file": name, **row} for name, row in counts.items()]
+    return rows
+
+
+def reader_counts(n_cases, seed, workers, collect=False):
+    """``n_cases`` (10,000) mutated real files per reader; the table per reader and source.
+
+    With ``collect``, no new job: the table of the jobs saved by an earlier run.
+    """
+    if _shared_data() is None:
+        print("The real files are not found: no per-reader run.")
+        return []
+    jobs = [
+        (reader, min(_CHUNK, n_cases - start), seed, k)
+        for k, start in enumerate(range(0, n_cases, _CHUNK))
+        for reader in reader_fuzz.READERS
+    ]
+    start = time.perf_counter()
+    results = []
+    if collect:
+        for reader, _, _, k in jobs:
+            job_file = _JOBS / f"{seed}-{reader}-{k}.json"
+            if job_file.exists():
+                saved = json.loads(job_file.read_text())
+                results.append((reader, saved["counts"], saved["failures"]))
+    else:
+        with multiprocessing.get_context("spawn").Pool(workers, maxtasksperchild=1) as pool:
+            results = list(pool.imap_unordered(_fuzz_one_chunk, jobs))
+    seconds = time.perf_counter() - start
+    rows = _table(results)
+    failures = [f for _, _, found in results for f in found]
+    finished = f"{len(results)} of {len(jobs)} jobs finished"
+    notes = (
+        f"{n_cases} mutations of real files per reader (round robin over its files), seed "
+        f"{seed}, in jobs of {_CHUNK} cases (each its own random stream) over {workers} worker "
+        f"processes with {_MEMORY_CAP >> 30} GiB of address space each; {finished}"
+        f"{'' if collect else f', {seconds:.0f} s'}. "
+        "rejected: MotionFileError naming the file (and, for text, a line inside it); "
+        "agrees: read, equal to an independent reference of the mutated bytes (a plain NumPy "
+        "decode of the C3D data block; a plain-splitting parse of BVH, ASF, AMC and keypoint "
+        "text; numpy.load of .npy/.npz bytes whose header fits the file); equal: a layout-only "
+        "change read equal to the original; by the file: a C3D header or parameter edit (or "
+        "a truncation) the data still backs, read as the edited file states (no independent "
+        "truth). Failures: crash (any other exception, MemoryError included), hang (no answer "
+        "in 5 s), allocation (tracemalloc peak past 2x (file size + the answer's arrays) + "
+        "1 MB, or an answer past 4x the file size), wrong (read, and different from the "
+        "reference)."
+    )
+    write_results("bench_fuzz_readers", rows, notes=notes)
+    for failure in failures[:40]:
+        print("FAILURE", failure)
+    return failures
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--cases", type=int, default=1500, help="mutations per source (0: none)")
@@ -167,7 +271,18 @@ def main():
     parser.add_argument(
         "--binary-cases", type=int, default=2500, help="mutations per binary source (0: none)"
     )
+    parser.add_argument(
+        "--per-reader", type=int, default=0, help="mutated real files per reader (0: none)"
+    )
+    parser.add_argument("--workers", type=int, default=2, help="processes of the per-reader run")
+    parser.add_argument(
+        "--collect", action="store_true", help="per-reader table of the jobs an earlier run saved"
+    )
     args = parser.parse_args()
+    if args.per_reader > 0:
+        reader_failures = reader_counts(args.per_reader, args.seed, args.workers, args.collect)
+        if reader_failures:
+            return 1
     failures = fuzz_counts(args.cases, args.seed).failures if args.cases > 0 else []
     if args.binary_cases > 0:
         failures += binary_counts(args.binary_cases, args.seed).failures

@@ -310,6 +310,12 @@ def read_c3d(path, *, units="m"):
             f"the header's {meta.header['analog_per_frame']} analog samples per frame are not "
             f"a whole number per channel of ANALOG:USED={n_analog}",
         )
+    # What the parameters say is checked before the data block is decoded: a bad
+    # unit or event fails fast, without first allocating the positions.
+    file_unit = (meta.strings("POINT:UNITS") or [""])[0].lower()
+    factor, units = _unit_scale(path, file_unit, units)
+    labels = _labels(meta, "POINT", n_points)
+    events = _events(meta, rate)
     word = 4 if scale < 0 else 2
     point_bytes = 4 * n_points * word
     frame_bytes = point_bytes + meta.header["analog_per_frame"] * word
@@ -319,8 +325,6 @@ def read_c3d(path, *, units="m"):
     xyz, residuals, invalid = _decode_points(
         block[:, :point_bytes], meta.processor, scale, n_points
     )
-    file_unit = (meta.strings("POINT:UNITS") or [""])[0].lower()
-    factor, units = _unit_scale(path, file_unit, units)
     if factor != 1.0:
         xyz *= factor
     xyz[invalid] = np.nan
@@ -330,9 +334,9 @@ def read_c3d(path, *, units="m"):
         xyz.reshape(n_frames, 3 * n_points),
         frame_rate=rate,
         source=str(path),
-        marker_names=_labels(meta, "POINT", n_points),
+        marker_names=labels,
         units=units,
         extras={"residuals": residuals},
         analog=_analog(meta, block[:, point_bytes:], n_frames, rate),
-        events=_events(meta, rate),
+        events=events,
     )

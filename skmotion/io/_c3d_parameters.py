@@ -43,7 +43,8 @@ def dec_to_float(words):
     """
     bits = np.asarray(words).reshape(-1).view("<u4")
     swapped = ((bits << np.uint32(16)) | (bits >> np.uint32(16))).astype("<u4")
-    return swapped.view("<f4") / np.float32(4.0)
+    with np.errstate(invalid="ignore"):  # junk words (NaN patterns) are checked by the caller
+        return swapped.view("<f4") / np.float32(4.0)
 
 
 def _int8(byte):

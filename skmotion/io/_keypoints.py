@@ -6,6 +6,7 @@ object with a ``joints`` or ``joint_names`` sequence, or a layout name that
 """
 
 import io
+import re
 import zipfile
 from pathlib import Path
 
@@ -13,7 +14,7 @@ import numpy as np
 
 from skmotion.io._errors import MotionFileError
 from skmotion.io._motion import Motion
-from skmotion.io._text import read_bytes
+from skmotion.io._text import NUMBER, decode_text, read_text
 from skmotion.kinematics._named_layouts import get_layout
 
 __all__ = ["read_keypoints"]
@@ -21,6 +22,8 @@ __all__ = ["read_keypoints"]
 # Values per joint by default: 2 -> x, y; 3 -> x, y, z; 4 -> x, y, z and a confidence.
 _DEFAULT_COLUMNS = {2: "xy", 3: "xyz", 4: "xyzc"}
 _COLUMNS = ("xy", "xyz", "xyc", "xyzc")
+_BLANKS = re.compile(r"[ \t]+")
+_NOT_NUMERIC = re.compile(r"[^0-9+\-.eEnNaA, \t\n]")
 
 
 def _joint_names(layout):
@@ -40,20 +43,25 @@ def _joint_names(layout):
 
 
 def _is_number(word):
-    """Whether numpy.loadtxt reads ``word`` as a finite float (no ``1_000``, no infinity)."""
-    try:
-        return "_" not in word and not np.isinf(float(word))
-    except ValueError:
-        return False
+    """Whether ``word`` is a finite ASCII number or NaN (no ``1_000``, no infinity)."""
+    return bool(NUMBER.fullmatch(word)) or word.lower().lstrip("+-") == "nan"
+
+
+def _values_of(text, delimiter):
+    """The words of a line's text without its comment: split at commas, or at spaces and
+    tabs (not at other Unicode blanks: a no-break space inside a number is an error)."""
+    text = text.split("#", 1)[0].strip(" \t")
+    if not text:
+        return []
+    return [w.strip(" \t") for w in (text.split(",") if delimiter else _BLANKS.split(text))]
 
 
 def _find_bad_line(path, lines, delimiter, first, n_values):
     """The MotionFileError naming the first line of ``lines[first:]`` that does not parse."""
     for number, line in enumerate(lines[first:], start=first + 1):
-        text = line.split("#", 1)[0].strip()
-        if not text:
+        words = _values_of(line, delimiter)
+        if not words:
             continue
-        words = [w.strip() for w in text.split(delimiter)]
         if n_values is not None and len(words) != n_values:
             return MotionFileError(path, number, f"{len(words)} values, expected {n_values}")
         bad = next((w for w in words if not _is_number(w)), None)
@@ -63,29 +71,30 @@ def _find_bad_line(path, lines, delimiter, first, n_values):
 
 
 def _read_text(path):
-    """(values of shape (n_rows, n_values), header names or None) of a text table."""
-    text = read_bytes(path).decode("utf-8-sig", errors="replace")
-    lines = text.splitlines()
-    data_lines = [k for k, line in enumerate(lines) if line.split("#", 1)[0].strip()]
+    """(values of shape (n_rows, n_values), (header names, line) or None) of a text table.
+
+    The one text rule of every reader (``skmotion.io._text``): a UTF-8 byte-order mark
+    is dropped, LF, CRLF and CR end a line, another control byte is an error naming
+    its line, and numbers are ASCII.
+    """
+    lines = decode_text(read_text(path)).split("\n")
+    data_lines = [k for k, line in enumerate(lines) if _values_of(line, None)]
     if not data_lines:
         raise MotionFileError(path, None, "no data lines")
     first = data_lines[0]
-    delimiter = "," if "," in lines[first] else None
-    words = [w.strip() for w in lines[first].split("#", 1)[0].split(delimiter)]
+    delimiter = "," if "," in lines[first].split("#", 1)[0] else None
+    words = _values_of(lines[first], delimiter)
     header = None
     if not any(_is_number(w) for w in words):  # a header names every column
-        header, first = words, first + 1
+        header, first = (words, first + 1), first + 1
     n_values = len(words)  # every line has as many values as the first
-    if not any(line.split("#", 1)[0].strip() for line in lines[first:]):
+    body = "\n".join(line.split("#", 1)[0] for line in lines[first:])
+    if not body.strip(" \t\n"):
         raise MotionFileError(path, None, "no data lines (a header only)")
+    if _NOT_NUMERIC.search(body):  # what numpy would read loosely (Unicode blanks, digits)
+        raise _find_bad_line(path, lines, delimiter, first, n_values)
     try:
-        values = np.loadtxt(
-            io.StringIO("\n".join(lines[first:])),
-            delimiter=delimiter,
-            comments="#",
-            ndmin=2,
-            dtype=float,
-        )
+        values = np.loadtxt(io.StringIO(body), delimiter=delimiter, ndmin=2, dtype=float)
     except ValueError:
         raise _find_bad_line(path, lines, delimiter, first, n_values) from None
     if values.size == 0:
@@ -186,18 +195,28 @@ def _read_array(path):
     return arrays[main[0]], names, arrays.get("confidence")
 
 
-def _joints_from_header(path, header, n_values):
-    """Joint names from column names ``<joint>_<x|y|z|c...>``, checked group by group."""
-    if len(header) % n_values:
-        raise MotionFileError(path, 1, f"{len(header)} columns, not {n_values} per joint")
-    groups = np.asarray(header, dtype=object).reshape(-1, n_values)
+def _joints_from_header(path, header, line, columns):
+    """Joint names from column names ``<joint>_<x|y|z|c...>``, checked group by group.
+
+    A column named for an axis must be that axis (``hip_y`` where ``columns`` puts x
+    would swap the axes silently); a confidence column may be named anything.
+    """
+    if len(header) % len(columns):
+        raise MotionFileError(path, line, f"{len(header)} columns, not {len(columns)} per joint")
+    groups = np.asarray(header, dtype=object).reshape(-1, len(columns))
     names = []
     for group in groups:
         stems = {str(c).rsplit("_", 1)[0] for c in group}
         if len(stems) != 1:
             raise MotionFileError(
-                path, 1, f"columns {list(group)} do not name one joint (<joint>_x, <joint>_y, ...)"
+                path,
+                line,
+                f"columns {list(group)} do not name one joint (<joint>_x, <joint>_y, ...)",
             )
+        for column, axis in zip(group, columns):
+            suffix = column.rsplit("_", 1)[-1].lower()
+            if axis in "xyz" and suffix in ("x", "y", "z") and suffix != axis:
+                raise MotionFileError(path, line, f"column {column!r} where {axis} belongs")
         names.append(stems.pop())
     return names
 
@@ -343,15 +362,17 @@ def read_keypoints(
         values, header = _read_text(path)
         file_names = None
         if header is not None:
-            n_values = len(columns) if columns else None
-            if n_values is None:
-                n_values = len(header) // len(names) if names else None
-            if n_values is None:
+            header, line = header
+            header_columns = columns
+            if header_columns is None and names:
+                per_joint = max(len(header) // len(names), 1)
+                header_columns = _DEFAULT_COLUMNS.get(per_joint, "?" * per_joint)
+            if header_columns is None:
                 raise ValueError(f"{path}: give layout= or columns= to split the header.")
-            file_names = _joints_from_header(path, header, n_values)
+            file_names = _joints_from_header(path, header, line, header_columns)
     if names is not None and file_names is not None and list(file_names) != names:
         raise MotionFileError(
-            path, 1 if header else None, f"joints {list(file_names)[:6]}... are not the layout's"
+            path, line if header else None, f"joints {list(file_names)[:6]}... are not the layout's"
         )
     frames = _as_frames(path, values, names or file_names, columns, per_line)
     n_frames, n_joints, n_values = frames.shape

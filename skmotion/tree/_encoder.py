@@ -26,6 +26,7 @@ from skmotion.tree._encoding._histograms import (
     second_order_features,
 )
 from skmotion.tree._encoding._routing import TreeRouter
+from skmotion.tree._magnitude import check_magnitude
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._features import channel_names_in
@@ -251,6 +252,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         if self.moments and not moment_pyramid:
             raise ValueError("moment_pyramid must name at least one level, e.g. (1,) or (1, 2, 4).")
         clips = check_clips(X, estimator=self, reset=True)
+        check_magnitude(clips, self)
         frames, _ = stack_clips(clips)
         self.moment_center_, spread = column_mean_std(frames)  # no centred copy
         self.moment_scale_ = np.where(spread > 0, spread, 1.0)
@@ -322,6 +324,14 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         """
         check_is_fitted(self, "tree_")
         clips = check_clips(X, estimator=self)
+        check_magnitude(clips, self)
+        check_magnitude(
+            clips,
+            self,
+            center=self.moment_center_,
+            scale=self.moment_scale_,
+            why="sums squares of the values in training spreads, which overflow float64",
+        )
         sparse = self._sparse()
         if sparse and self._output_config() == "pandas":
             raise ValueError(

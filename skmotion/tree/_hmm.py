@@ -42,6 +42,7 @@ from skmotion.tree._growth import (
     regraph,
     union_classes,
 )
+from skmotion.tree._magnitude import SCORE_LIMIT, check_magnitude
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.tree._online import MotionStream, OnlineMotionStream
 from skmotion.tree._transitions import count_database_graphs
@@ -303,6 +304,7 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
     def _fit(self, X, y, groups):
         """``fit``; returns the validated clips and their held-out per-layer class scores."""
         clips = check_clips(X, estimator=self, reset=True)
+        check_magnitude(clips, self)
         y = check_clip_labels(check_label_types(y), len(clips))
         self.classes_, y_index = np.unique(y, return_inverse=True)
         frames, offsets = stack_clips(clips)
@@ -591,9 +593,27 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
             ``log`` of the summed probability of the ``n_paths`` best node
             sequences at ``layer_`` (summed over ``score_layers_`` when there
             are several); columns follow ``classes_``.
+
+        Raises
+        ------
+        ValueError
+            A value more than 1e5 training spreads from the training mean
+            (naming its clip and channel): there the log-probability is
+            rounding noise. :meth:`predict_proba` and :meth:`novelty_score`
+            still answer for such clips.
         """
         check_is_fitted(self)
-        return self._class_log_probs(check_clips(X, estimator=self))
+        clips = check_clips(X, estimator=self)
+        check_magnitude(
+            clips,
+            self,
+            center=self.center_,
+            scale=self.scale_,
+            limit=SCORE_LIMIT,
+            why=f"scores values up to {SCORE_LIMIT:g} training spreads from the training mean "
+            "(past them a log-probability is rounding noise)",
+        )
+        return self._class_log_probs(clips)
 
     def decision_function(self, X):
         """Per-frame log generation probability of each clip under each class, over the temperature.

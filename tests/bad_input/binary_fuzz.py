@@ -28,6 +28,7 @@ the time limit (a hang), a peak allocation past twice the file's size (plus 1 MB
 or a read that disagrees with its reference (a silent wrong read).
 """
 
+import ast
 import io
 import signal
 import struct
@@ -102,10 +103,14 @@ def _c3d_layout(data):
     return data_start, 4 * (4 * n_points + n_analog), last - first + 1
 
 
-def mutate_c3d(data, rng):
-    """(description, mutated bytes, kind) with kind in {"header", "parameter", "data", "cut"}."""
+def mutate_c3d(data, rng, layout=None):
+    """(description, mutated bytes, kind) with kind in {"header", "parameter", "data", "cut"}.
+
+    ``layout`` is the (data start byte, frame bytes, n_frames) of a file that the
+    writer did not make (default: the writer's float32 layout).
+    """
     data = bytearray(data)
-    start, frame_bytes, n_frames = _c3d_layout(data)
+    start, frame_bytes, n_frames = layout or _c3d_layout(data)
     kind = rng.choice(["header", "parameter", "data", "cut"], p=[0.35, 0.3, 0.2, 0.15])
     if kind == "header":
         name = str(rng.choice(list(_HEADER_FIELDS)))
@@ -167,40 +172,50 @@ def judge_c3d(result, original, data, kind, mutated):
 
 
 # -- .npy / .npz ---------------------------------------------------------------------
-def written_npy(rng):
+def npy_bytes(values):
     buffer = io.BytesIO()
-    np.save(buffer, rng.normal(size=(30, 4, 3)))
+    np.save(buffer, values)
     return buffer.getvalue()
+
+
+def npz_bytes(values, names=None, compressed=False):
+    buffer = io.BytesIO()
+    arrays = {"keypoints": values}
+    if names is not None:
+        arrays["joint_names"] = np.array(names)
+    (np.savez_compressed if compressed else np.savez)(buffer, **arrays)
+    return buffer.getvalue()
+
+
+def written_npy(rng):
+    return npy_bytes(rng.normal(size=(30, 4, 3)))
 
 
 def written_npz(rng):
-    buffer = io.BytesIO()
-    np.savez(buffer, keypoints=rng.normal(size=(30, 4, 3)), joint_names=np.array(list("abcd")))
-    return buffer.getvalue()
+    return npz_bytes(rng.normal(size=(30, 4, 3)), list("abcd"))
 
 
 def _new_header(header, rng):
     """An .npy header dict text with one field edited."""
+    fields = ast.literal_eval(header.strip())
+    shape, rest = fields["shape"], fields["shape"][1:]
     choice = rng.integers(0, 4)
     if choice == 0:
-        shape = rng.choice(
-            [
-                "(30, 4, 3)",
-                "(10**9, 4, 3)",
-                "(2**62, 2**62)",
-                "(-1, 4, 3)",
-                "(30, 4, 3, 1000000)",
-                "()",
-                "(0, 4, 3)",
-                "(31, 4, 3)",
-                "(15, 4, 3)",
-            ]
-        )
-        shape = str(eval(shape)) if "**" in shape else shape  # noqa: S307 - our own literals
-        return header.replace("(30, 4, 3)", shape), f"shape {shape}"
+        new = [
+            shape,
+            (10**9, *rest),
+            (2**62, 2**62),
+            (-1, *rest),
+            (*shape, 1000000),
+            (),
+            (0, *rest),
+            (shape[0] + 1, *rest),
+            (shape[0] // 2, *rest),
+        ][int(rng.integers(0, 9))]
+        return header.replace(repr(shape), repr(new)), f"shape {new}"
     if choice == 1:
         descr = str(rng.choice(["|O", "<c16", ">f8", "<f4", "|V8", "<M8[s]", "|b1", "<U2", "xyz"]))
-        return header.replace("'<f8'", repr(descr)), f"descr {descr}"
+        return header.replace(repr(fields["descr"]), repr(descr)), f"descr {descr}"
     if choice == 2:
         return header.replace("False", "True"), "fortran_order True"
     return header.replace("}", ", 'extra': (((}"), "garbled dict"

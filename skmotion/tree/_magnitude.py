@@ -1,0 +1,73 @@
+"""Values too large for the motion tree's arithmetic: a ValueError naming clip and channel.
+
+Two limits, each the point past which an answer would be NaN, infinite or garbage
+rather than a number:
+
+- :func:`overflow_limit`: fitting and encoding sum squares of the values over the
+  frames (variances, covariances, Fisher-vector terms, moments); past
+  ``sqrt(max float / (4 n_frames n_channels))`` those sums overflow float64.
+- :data:`SCORE_LIMIT`: a generation log-probability evaluates each Gaussian as an
+  expanded quadratic form, whose rounding error grows as the square of the
+  standardised deviation; past 1e5 training spreads from the training mean the
+  error of a score reaches hundredths of a nat (at 4e6, whole nats; at 4e7 the
+  scores of every class are rounding noise). ``predict_proba`` and
+  ``novelty_score`` keep their own documented answers for such clips (uniform
+  rows, ``-inf``); ``score_samples``, whose values are the answer, refuses them.
+"""
+
+import numpy as np
+
+__all__ = ["SCORE_LIMIT", "check_magnitude", "overflow_limit"]
+
+#: Standardised deviations past which a generation log-probability is not reliable.
+SCORE_LIMIT = 1e5
+
+
+def overflow_limit(clips):
+    """The largest absolute value whose squares, summed over every frame and channel
+    of ``clips`` (and after centring, which can double a value), stay finite."""
+    n_values = sum(clip.size for clip in clips)
+    return float(np.sqrt(np.finfo(np.float64).max / (4.0 * max(n_values, 1))))
+
+
+def check_magnitude(clips, estimator, *, center=0.0, scale=1.0, limit=None, why=None):
+    """Raise a ValueError naming the first clip and channel whose ``|(x - center) / scale|``
+    passes ``limit`` (default :func:`overflow_limit`).
+
+    Parameters
+    ----------
+    clips : list of ndarray of shape (n_frames_i, n_channels)
+        Finite clips (``check_clips`` has refused NaN and infinity).
+    estimator : estimator
+        Named in the message.
+    center, scale : float or ndarray of shape (n_channels,)
+        Given, the limit is in training spreads from the training mean.
+    limit : float, default=None
+    why : str, default=None
+        What passing the limit breaks, for the message.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree._magnitude import check_magnitude
+    >>> from skmotion.tree import MotionTreeEncoder
+    >>> clips = [np.zeros((5, 2)), np.array([[0.0, 1e300]] * 5)]
+    >>> check_magnitude(clips, MotionTreeEncoder())
+    Traceback (most recent call last):
+    ...
+    ValueError: X: clip 1, channel 1 holds 1e+300; MotionTreeEncoder sums squares of the values, which overflow float64 past 1.5e+153: rescale the data (check its units).
+    """  # noqa: E501
+    limit = overflow_limit(clips) if limit is None else limit
+    why = why or f"sums squares of the values, which overflow float64 past {limit:.3g}"
+    for i, clip in enumerate(clips):
+        with np.errstate(over="ignore", invalid="ignore"):
+            reach = np.abs((clip - center) / scale)
+        worst = reach.max(axis=0, initial=0.0)
+        bad = np.flatnonzero(~(worst <= limit))
+        if bad.size:
+            j = int(bad[0])
+            value = clip[np.argmax(reach[:, j]), j]
+            raise ValueError(
+                f"X: clip {i}, channel {j} holds {value:.3g}; {type(estimator).__name__} "
+                f"{why}: rescale the data (check its units)."
+            )
