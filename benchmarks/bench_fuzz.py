@@ -207,16 +207,19 @@ def _table(results):
     rows = []
     for reader in reader_fuzz.READERS:
         counts = totals[reader]
+        if not counts:  # a reader this run left out
+            continue
         total = {k: sum(row[k] for row in counts.values()) for k in reader_fuzz.OUTCOMES}
         rows.append({"reader": reader, "file": "all", **total})
         rows += [{"reader": reader, "file": name, **row} for name, row in counts.items()]
     return rows
 
 
-def reader_counts(n_cases, seed, workers, collect=False):
+def reader_counts(n_cases, seed, workers, collect=False, readers=reader_fuzz.READERS):
     """``n_cases`` (10,000) mutated real files per reader; the table per reader and source.
 
-    With ``collect``, no new job: the table of the jobs saved by an earlier run.
+    With ``collect``, no new job: the table of the jobs saved by an earlier run. ``readers``
+    limits the run to some readers (e.g. to run one again after a fix).
     """
     if _shared_data() is None:
         print("The real files are not found: no per-reader run.")
@@ -224,7 +227,7 @@ def reader_counts(n_cases, seed, workers, collect=False):
     jobs = [
         (reader, min(_CHUNK, n_cases - start), seed, k)
         for k, start in enumerate(range(0, n_cases, _CHUNK))
-        for reader in reader_fuzz.READERS
+        for reader in readers
     ]
     start = time.perf_counter()
     results = []
@@ -276,11 +279,20 @@ def main():
     )
     parser.add_argument("--workers", type=int, default=2, help="processes of the per-reader run")
     parser.add_argument(
+        "--readers",
+        nargs="+",
+        choices=reader_fuzz.READERS,
+        default=reader_fuzz.READERS,
+        help="readers of the per-reader run (all by default)",
+    )
+    parser.add_argument(
         "--collect", action="store_true", help="per-reader table of the jobs an earlier run saved"
     )
     args = parser.parse_args()
     if args.per_reader > 0:
-        reader_failures = reader_counts(args.per_reader, args.seed, args.workers, args.collect)
+        reader_failures = reader_counts(
+            args.per_reader, args.seed, args.workers, args.collect, tuple(args.readers)
+        )
         if reader_failures:
             return 1
     failures = fuzz_counts(args.cases, args.seed).failures if args.cases > 0 else []
