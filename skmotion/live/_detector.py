@@ -23,10 +23,21 @@ from skmotion.utils._sklearn_compat import HasMethods, Interval, StrOptions, _fi
 __all__ = ["GestureDetector"]
 
 
-def _labels_per_point(y, action_points):
-    """Per take, the label of each action point: ``y`` gives one per take or one per point."""
-    sizes = [len(points) for points in action_points]
-    return labels_per_take(y, sizes, "take {i} has {got} labels for its {n} action points.")
+def training_takes(estimator, X, y, action_points):
+    """The checked takes of a detector's ``fit``, their action points and each point's label.
+
+    Both detectors train on the same input; the rejection class may label no action point.
+    """
+    clips = check_clips(X, estimator=estimator, reset=True)
+    if len(y) != len(clips):
+        raise ValueError(f"y: {len(y)} labels for {len(clips)} takes.")
+    points = _check_points(action_points, clips)
+    sizes = [len(take_points) for take_points in points]
+    labels = labels_per_take(y, sizes, "take {i} has {got} labels for its {n} action points.")
+    none = estimator.none_label
+    if any(none in set(names) for names in labels):
+        raise ValueError(f"y: the rejection class {none!r} labels an action point.")
+    return clips, points, labels
 
 
 def _check_points(action_points, clips):
@@ -208,13 +219,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         self : GestureDetector
             The fitted detector.
         """
-        clips = check_clips(X, estimator=self, reset=True)
-        if len(y) != len(clips):
-            raise ValueError(f"y: {len(y)} labels for {len(clips)} takes.")
-        points = _check_points(action_points, clips)
-        labels = _labels_per_point(y, points)
-        if any(self.none_label in set(names) for names in labels):
-            raise ValueError(f"y: the rejection class {self.none_label!r} labels an action point.")
+        clips, points, labels = training_takes(self, X, y, action_points)
         rng = np.random.default_rng(check_random_state(self.random_state).randint(2**31))
         windows, targets = training_windows(
             clips,

@@ -10,7 +10,7 @@ from sklearn.utils import check_random_state
 from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
-from skmotion.live._detector import _check_points, _labels_per_point
+from skmotion.live._detector import training_takes
 from skmotion.live._events import TRIGGERS, TriggerState, next_events
 from skmotion.live._window_kernel import frame_features, window_scores
 from skmotion.live._windows import training_ends
@@ -232,13 +232,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self : LinearGestureDetector
             The fitted detector.
         """
-        clips = check_clips(X, estimator=self, reset=True)
-        if len(y) != len(clips):
-            raise ValueError(f"y: {len(y)} labels for {len(clips)} takes.")
-        points = _check_points(action_points, clips)
-        labels = _labels_per_point(y, points)
-        if any(self.none_label in set(names) for names in labels):
-            raise ValueError(f"y: the rejection class {self.none_label!r} labels an action point.")
+        clips, points, labels = training_takes(self, X, y, action_points)
         self._joints()
         # each positive window also ends up to `jitter` frames from its action point
         shifts = np.arange(-self.jitter, self.jitter + 1)
