@@ -149,13 +149,17 @@ def _c3d_reference(original, mutated):
     return xyz.reshape(n_frames, -1) / 1000.0
 
 
-def judge_c3d(result, original, data, kind, mutated):
-    """The outcome of a C3D read that did not raise."""
+def judge_c3d(result, original, data, kind, mutated, *, decode=None):
+    """The outcome of a C3D read that did not raise.
+
+    ``decode(mutated)`` is the independent decode of the data block (by default the plain
+    float32 one of the files this module writes).
+    """
     same = result.channels.shape == original.channels.shape and np.array_equal(
         result.channels, original.channels, equal_nan=True
     )
     if kind == "data":
-        expected = _c3d_reference(data, mutated)
+        expected = _c3d_reference(data, mutated) if decode is None else decode(mutated)
         if result.channels.shape == expected.shape and np.allclose(
             result.channels, expected, rtol=1e-12, atol=0, equal_nan=True
         ):
