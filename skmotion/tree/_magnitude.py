@@ -60,13 +60,21 @@ def check_magnitude(clips, estimator, *, center=0.0, scale=1.0, limit=None, why=
     limit = overflow_limit(clips) if limit is None else limit
     why = why or f"sums squares of the values, which overflow float64 past {limit:.3g}"
     for i, clip in enumerate(clips):
+        if not clip.size:
+            continue
+        # |x - c| / s is largest at a channel's maximum or minimum (the map is monotonic,
+        # also in rounding): two reductions, no frame-sized temporaries on every call
+        center_i = np.broadcast_to(center, clip.shape[1:])
+        scale_i = np.broadcast_to(scale, clip.shape[1:])
         with np.errstate(over="ignore", invalid="ignore"):
-            reach = np.abs((clip - center) / scale)
-        worst = reach.max(axis=0, initial=0.0)
+            high = np.abs(clip.max(axis=0) - center_i)
+            worst = np.maximum(high, np.abs(clip.min(axis=0) - center_i)) / scale_i
         bad = np.flatnonzero(~(worst <= limit))
         if bad.size:
             j = int(bad[0])
-            value = clip[np.argmax(reach[:, j]), j]
+            with np.errstate(over="ignore", invalid="ignore"):
+                reach = np.abs((clip[:, j] - center_i[j]) / scale_i[j])
+            value = clip[np.argmax(reach), j]
             raise ValueError(
                 f"X: clip {i}, channel {j} holds {value:.3g}; {type(estimator).__name__} "
                 f"{why}: rescale the data (check its units)."
