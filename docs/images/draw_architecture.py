@@ -25,7 +25,9 @@ ROLES = {
     "planning": "A* on the transition graph",
     "plotting": "figures (matplotlib)",
     "metrics": "pruning, recall",
-    "neighbors": "IntervalIndexNeighbors,\nShardedIntervalIndex, psi",
+    "neighbors": "IntervalIndexNeighbors, MotionMatcher,\nfind_occurrences, psi",
+    "recognition": "MotionClassifier",
+    "live": "GestureDetector, LinearGestureDetector,\nActivitySegmenter",
     "tree": "MotionTree, MotionTreeHMM,\nMotionTreeEncoder",
     "control": "primitives, arm simulation",
     "decomposition": "SVDFeatureExtractor,\nEigenMovementPCA",
@@ -37,7 +39,7 @@ ROLES = {
     "kinematics": "skeletons, layouts, rotations",
     "utils": "check_clips, containers, parallel",
 }
-SUBPACKAGES = {"tree": ["_decoder", "_online", "_growth"]}
+SUBPACKAGES = {"tree": ["_build", "_decoder", "_encoding", "_online", "_growth"]}
 
 
 def unit_of(path):
@@ -131,8 +133,8 @@ def draw(out):
         ax.text(x, y - 0.08, ROLES[unit], ha="center", va="center", fontsize=8, zorder=3)
         subs = SUBPACKAGES.get(unit)
         if subs:
-            label = "sub-packages " + "  ".join(f"{s}/" for s in subs)
-            ax.text(x, y - 0.36, label, ha="center", va="center", fontsize=7.5, style="italic")
+            label = "sub-packages " + " ".join(f"{s}/" for s in subs)
+            ax.text(x, y - 0.36, label, ha="center", va="center", fontsize=6.5, style="italic")
     xs = [p[0] for p in place.values()]
     ax.set_xlim(min(xs) - width, max(xs) + width)
     ax.set_ylim(-1.0, (n_floors - 1) * 1.9 + 1.0)
