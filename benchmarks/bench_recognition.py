@@ -102,8 +102,7 @@ def synthetic_angles():
 def cmu_windows():
     if not (SHARED_DATA / "cmu-asfamc").is_dir():
         return None
-    Xtr, ytr, Xte, yte = _cmu_windows()
-    return Xtr, ytr, Xte, yte, None, {}
+    return (*_cmu_windows(groups=True), {})
 
 
 def uea(name):
