@@ -114,7 +114,7 @@ def cmu_markers(subjects):
     return [m[::step] for m in markers], data
 
 
-def cmu_windows():
+def cmu_windows(groups=False):
     """CMU subject 02 cut into windows, split by time inside each trial: Xtr, ytr, Xte, yte.
 
     Each trial (30 Hz virtual markers) is cut at 60% of its frames: training
@@ -122,9 +122,15 @@ def cmu_windows():
     window overlaps across train and test (windows overlap only within one side).
     Windows: 1 s (30 frames), 0.5 s hop. The run/jog trial (02_03, 1.4 s) is
     too short for a window on both sides and is left out: 6 classes.
+
+    With ``groups=True`` a fifth array follows: the third of its trial's training
+    part that holds the centre of each training window (0, 1, 2), so that grouped CV holds
+    out a stretch of every trial, as the test split does (only the windows at a
+    border overlap a held-out one, by half a window), instead of folds whose
+    windows overlap the held-out ones on both sides.
     """
     clips, data = cmu_markers([2])
-    Xtr, ytr, Xte, yte = [], [], [], []
+    Xtr, ytr, Xte, yte, gtr = [], [], [], [], []
     for clip, description in zip(clips, data.description):
         label = CMU_CLASSES[description]
         cut = int(CMU_TRAIN_SHARE * len(clip))
@@ -132,7 +138,10 @@ def cmu_windows():
             for start in range(0, len(part) - CMU_WINDOW + 1, CMU_HOP):
                 X.append(part[start : start + CMU_WINDOW])
                 y.append(label)
-    ytr, yte = np.asarray(ytr), np.asarray(yte)
+                if X is Xtr:
+                    gtr.append(min(2, 3 * (start + CMU_WINDOW // 2) // len(part)))
+    ytr, yte, gtr = np.asarray(ytr), np.asarray(yte), np.asarray(gtr)
     both = np.intersect1d(ytr, yte)
     pick = lambda X, y: ([x for x, label in zip(X, y) if label in both], y[np.isin(y, both)])  # noqa: E731
-    return (*pick(Xtr, ytr), *pick(Xte, yte))
+    out = (*pick(Xtr, ytr), *pick(Xte, yte))
+    return (*out, gtr[np.isin(ytr, both)]) if groups else out

@@ -55,18 +55,22 @@ from skmotion.tree import MotionTreeEncoder, MotionTreeHMM  # noqa: E402
 
 PEER_FRAMES = 32
 STUDY = {  # candidate -> MotionClassifier parameters (the defaults are the first)
-    "defaults (depth 6, residuals 1 3, means 1 2 4, C 0.1, velocity weight 1)": {},
-    "C 0.01": {"C": 0.01},
-    "C 0.001": {"C": 0.001},
+    "defaults (depth 6, residuals 1 3, means 1 2 4, column_power 0.5, C 1, velocity weight 1)": {},
+    "standardised columns (column_power 1), C 0.1": {"column_power": 1.0, "C": 0.1},
+    "columns in their units (column_power 0)": {"column_power": 0.0},
+    "column_power 0.25": {"column_power": 0.25},
+    "column_power 0.75": {"column_power": 0.75},
+    "C 0.1": {"C": 0.1},
+    "C 10": {"C": 10.0},
     "no moment pyramid (means over the whole clip)": {"moment_pyramid": (1,)},
     "means 1 2 4 8": {"moment_pyramid": (1, 2, 4, 8)},
     "depth 4": {"max_depth": 4},
     "depth 8": {"max_depth": 8},
-    "velocity weight 0.25": {"velocity_weight": 0.25},
     "velocity weight 0.5": {"velocity_weight": 0.5},
+    "velocity weight 2": {"velocity_weight": 2.0},
     "per-channel standardisation": {"scaling": "channels"},
 }
-CV_GRID = [{"C": c, "velocity_weight": w} for c in (0.03, 0.1, 0.3) for w in (0.5, 1.0)]
+CV_GRID = [{"C": c, "column_power": p} for c in (0.3, 1.0, 3.0) for p in (0.5, 1.0)]
 
 
 # -- the sets: (Xtr, ytr, Xte, yte, groups of the training clips, MotionClassifier kwargs) ------
@@ -98,8 +102,7 @@ def synthetic_angles():
 def cmu_windows():
     if not (SHARED_DATA / "cmu-asfamc").is_dir():
         return None
-    Xtr, ytr, Xte, yte = _cmu_windows()
-    return Xtr, ytr, Xte, yte, None, {}
+    return (*_cmu_windows(groups=True), {})
 
 
 def uea(name):
@@ -237,7 +240,7 @@ def models(kwargs, Xtr, with_dtw):
     vm_chain = [VirtualMarkerTransform(**markers)] if kwargs or hasattr(Xtr[0], "skeleton") else []
     out = {
         "MotionClassifier() (defaults)": MotionClassifier(**kwargs),
-        "MotionClassifier (C, velocity_weight by CV)": ("cv", MotionClassifier(**kwargs)),
+        "MotionClassifier (C, column_power by CV)": ("cv", MotionClassifier(**kwargs)),
         "MotionTreeHMM() (defaults)": make_pipeline(*vm_chain, MotionTreeHMM())
         if vm_chain
         else MotionTreeHMM(),

@@ -48,7 +48,7 @@ def _split(data, subject=3):
 
 
 def test_equals_its_steps_run_by_hand(positions):
-    """The estimator is exactly: markers, block scaling, the encoder, standardised columns, LR."""
+    """The estimator is exactly: markers, block scaling, the encoder, scaled columns, LR."""
     Xtr, ytr, Xte, _ = _split(positions)
     rate = positions.frame_rate
     model = MotionClassifier(layout="kinect_v2", frame_rate=rate, max_depth=4).fit(Xtr, ytr)
@@ -68,11 +68,16 @@ def test_equals_its_steps_run_by_hand(positions):
     encoder = MotionTreeEncoder(
         max_depth=4, layers="all", moment_pyramid=(1, 2, 4), standardize=False, sparse_output=False
     ).fit(S(Mtr))
-    head = make_pipeline(StandardScaler(), LogisticRegression(C=0.1, max_iter=1000))
-    head.fit(encoder.transform(S(Mtr)), ytr)
-    np.testing.assert_allclose(
-        model.predict_proba(Xte), head.predict_proba(encoder.transform(S(Mte))), atol=1e-10
-    )
+    Ftr, Fte = encoder.transform(S(Mtr)), encoder.transform(S(Mte))
+    # each column centred and divided by the square root of its standard deviation
+    root = lambda F: (F - Ftr.mean(axis=0)) / np.sqrt(Ftr.std(axis=0))  # noqa: E731
+    head = LogisticRegression(C=1.0, max_iter=1000).fit(root(Ftr), ytr)
+    np.testing.assert_allclose(model.predict_proba(Xte), head.predict_proba(root(Fte)), atol=1e-10)
+    # column_power=1 is sklearn's StandardScaler
+    standard = clone(model).set_params(column_power=1.0).fit(Xtr, ytr)
+    head = make_pipeline(StandardScaler(), LogisticRegression(C=1.0, max_iter=1000))
+    head.fit(Ftr, ytr)
+    np.testing.assert_allclose(standard.predict_proba(Xte), head.predict_proba(Fte), atol=1e-10)
 
 
 def test_beats_nearest_neighbour_on_a_held_out_subject(positions):
@@ -143,6 +148,7 @@ def test_plain_channels_are_standardised_one_by_one():
         ({"scaling": "blocks"}, "needs the marker step"),
         ({"layout": "kinect_v2", "skeleton": make_motions(1, random_state=0).skeleton}, "not both"),
         ({"C": 0.0}, "C"),
+        ({"column_power": 1.5}, "column_power"),
         ({"scaling": "per-channel"}, "scaling"),
     ],
 )
