@@ -15,6 +15,11 @@ benchmark builds: ``max_depth=8``, median cuts, ``min_samples_leaf=16``.
   in every layer (the recognition features of a frame are those of its nodes, so an
   agreement of 1 means identical encodings).
 
+- ``--dev``: on MSRC-12 repetitions (odd people train, even people test), the tree of
+  ``MotionTreeEncoder().fit`` and the out-of-core build over the same standardised
+  training frames: the share of test frames in the same node in every layer, and the
+  test accuracy of a logistic regression on the encoder's features with either tree.
+
 Results: ``results/<--name, default out_of_core>.{csv,md}`` (one row: name each
 run). Run: ``python benchmarks/bench_out_of_core.py --frames 10000000``.
 """
@@ -143,16 +148,78 @@ def compare_run(paths, n):
     }
 
 
+def dev_run(folder):
+    """MSRC-12 repetitions (``bench_live``): the encoder's tree built in memory and out of
+    core over the same standardised training frames, and the test accuracy of a logistic
+    regression on the encoder's features with either tree."""
+    import dask
+    from bench_live import msrc12_repetitions
+    from sklearn.linear_model import LogisticRegression
+
+    from skmotion.tree import MotionTreeEncoder, build_tree_out_of_core
+    from skmotion.tree._encoding import TreeRouter
+    from skmotion.utils import stack_clips
+
+    Xtr, ytr, Xte, yte = msrc12_repetitions()
+    encoder = MotionTreeEncoder().fit(Xtr)
+    frames, _ = stack_clips(Xtr)
+    folder.mkdir(parents=True, exist_ok=True)
+    paths = []
+    for i, part in enumerate(np.array_split((frames - encoder.center_) / encoder.scale_, 3)):
+        paths.append(folder / f"z{i}.npy")
+        np.save(paths[-1], part)
+    tree = encoder.tree_
+    params = dict(max_depth=tree.n_layers - 1, split=encoder.split, covariance_type="spherical")
+    with dask.config.set(scheduler="synchronous"):
+        ooc = build_tree_out_of_core(
+            paths, min_samples_leaf=encoder.min_samples_leaf, max_frames_per_task=len(frames) // 5,
+            **params,
+        )  # fmt: skip
+    out = MotionTreeEncoder().fit(Xtr)  # the same fit, its tree then replaced by ooc
+    out.tree_, out._router = ooc, TreeRouter(ooc, out.center_, out.scale_)
+    out._residual_means = [ooc.means(layer) for layer in out.residual_layers_]
+    test_z = (stack_clips(Xte)[0] - encoder.center_) / encoder.scale_
+    agree = min(
+        float(np.mean(tree.apply(test_z, layer) == ooc.apply(test_z, layer)))
+        for layer in range(tree.n_layers)
+    )
+    scores = []
+    for enc in (encoder, out):
+        model = LogisticRegression(max_iter=3000).fit(enc.transform(Xtr), ytr)
+        scores.append(model.score(enc.transform(Xte), yte))
+    return {
+        "run": "MSRC-12 repetitions: MotionTreeEncoder's tree in memory / out of core",
+        "frames": len(frames),
+        "same layer sizes as in memory": tree.n_nodes.tolist() == ooc.n_nodes.tolist(),
+        "test frames in the same node (worst layer)": agree,
+        "test accuracy, in-memory tree": scores[0],
+        "test accuracy, out-of-core tree": scores[1],
+        "largest feature difference": float(
+            np.abs(encoder.transform(Xte) - out.transform(Xte)).max()
+        ),
+    }
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=10_000_000)
     parser.add_argument("--compare", type=int, default=None)
+    parser.add_argument("--dev", action="store_true", help="MSRC-12: the encoder either way")
     parser.add_argument("--dir", default="/tmp/skmotion-out-of-core")
     parser.add_argument("--keep", action="store_true", help="keep the frame files")
     parser.add_argument("--name", default="out_of_core")
     args = parser.parse_args()
     n = args.compare or args.frames
     folder = Path(args.dir) / str(n)
+    if args.dev:
+        folder = Path(args.dir) / "dev"
+        try:
+            row = dev_run(folder)
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+        print(row)
+        write_results(args.name, [row], notes="OPENBLAS/OMP/MKL threads = 1")
+        return
     try:
         start = time.perf_counter()
         paths = write_frame_files(n, folder)
