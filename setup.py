@@ -88,6 +88,13 @@ permute = Extension(
     ["skmotion/tree/_build/_permute.pyx"],
     extra_compile_args=["-O3"],
 )
+# Frames walked down the upper layers of a motion tree from their projections, one compiled
+# loop instead of array operations per layer (tree/_encoding/_routing, the encoder's router).
+walk = Extension(
+    "skmotion.tree._encoding._walk",
+    ["skmotion/tree/_encoding/_walk.pyx"],
+    extra_compile_args=["-O3"],
+)
 # Frame features and window scores of the linear gesture detector, one frame at a time
 # (live/_linear_detector.py).
 live_window = Extension(
@@ -106,6 +113,7 @@ setup(
             occurrence_loops,
             group_sums,
             permute,
+            walk,
             live_window,
         ]
     )

@@ -4,6 +4,7 @@ import sys
 
 from skmotion.tree import _encoding, _growth, _online
 from skmotion.tree._build import PAPER_SETTINGS
+from skmotion.tree._build._out_of_core import build_tree_out_of_core
 from skmotion.tree._decoder import (
     NODE_PRIORS,
     beam_decode,
@@ -39,6 +40,7 @@ __all__ = [
     "PAPER_SETTINGS",
     "TransitionGraphs",
     "beam_decode",
+    "build_tree_out_of_core",
     "exhaustive_viterbi",
     "kbest_viterbi",
     "max_marginals",

@@ -26,7 +26,7 @@ from skmotion.tree._encoding._histograms import (
     second_order_features,
 )
 from skmotion.tree._encoding._routing import TreeRouter
-from skmotion.tree._magnitude import check_magnitude
+from skmotion.tree._magnitude import check_magnitude, check_stacked_magnitude
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._features import channel_names_in
@@ -37,6 +37,8 @@ __all__ = ["MotionTreeEncoder"]
 
 # "auto" gives a sparse matrix from this many occupancy and transition columns on.
 _SPARSE_FROM = 1024
+# transform's second magnitude check: the moments sum squares in training spreads
+_SPREADS_OVERFLOW = "sums squares of the values in training spreads, which overflow float64"
 
 
 class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
@@ -322,30 +324,25 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         X_new : ndarray or scipy.sparse.csr_matrix of shape (n_clips, n_features_out_)
             Or a DataFrame after ``set_output(transform="pandas")`` (dense output only).
         """
-        check_is_fitted(self, "tree_")
+        if "tree_" not in self.__dict__:  # sklearn's check costs more than a one-clip encoding
+            check_is_fitted(self, "tree_")
         clips = check_clips(X, estimator=self)
-        check_magnitude(clips, self)
-        check_magnitude(
-            clips,
-            self,
-            center=self.moment_center_,
-            scale=self.moment_scale_,
-            why="sums squares of the values in training spreads, which overflow float64",
-        )
+        frames, offsets = stack_clips(clips)
+        # the raw values, then in training spreads: one maximum and minimum per clip for both
+        checks = [(0.0, 1.0, None), (self.moment_center_, self.moment_scale_, _SPREADS_OVERFLOW)]
+        check_stacked_magnitude(frames, offsets, self, checks)
         sparse = self._sparse()
         if sparse and self._output_config() == "pandas":
             raise ValueError(
                 f"set_output(transform='pandas') needs dense output, but this encoder gives "
                 f"{self.n_features_out_} columns as a sparse matrix: set sparse_output=False."
             )
-        frames, offsets = stack_clips(clips)
-        layer_sets = (self.layers_, self.transition_layers_, self.residual_layers_)
-        routed = np.array(sorted({int(v) for layers in layer_sets for v in layers}), np.intp)
+        routed, residual_columns = self._routing_plan()
         # moments alone need no routing
         nodes = self._router.route(frames, routed) if len(routed) else None
         residual_nodes = None
         if len(self.residual_layers_):
-            residual_nodes = nodes[:, np.searchsorted(routed, self.residual_layers_)]
+            residual_nodes = nodes[:, residual_columns]
         parts = []
         if self._blocks:
             parts.append(histogram_features(nodes, offsets, routed, self._blocks, self.power))
@@ -390,6 +387,17 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         dense = [p.toarray() if sp.issparse(p) else p for p in parts]
         table = dense[0] if len(dense) == 1 else np.concatenate(dense, axis=1)
         return self._wrap_table(table, clips)
+
+    def _routing_plan(self):
+        """The layers routed (increasing) and the residual layers' columns among them; made
+        once per fit (on the first transform), as on one clip their making is felt."""
+        plan = self.__dict__.get("_plan")
+        if plan is None or plan[0] is not self.tree_:
+            layer_sets = (self.layers_, self.transition_layers_, self.residual_layers_)
+            routed = np.array(sorted({int(v) for layers in layer_sets for v in layers}), np.intp)
+            plan = (self.tree_, routed, np.searchsorted(routed, self.residual_layers_))
+            self._plan = plan
+        return plan[1:]
 
     def _sparse(self):
         if self.sparse_output == "auto":

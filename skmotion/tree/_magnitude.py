@@ -17,7 +17,7 @@ rather than a number:
 
 import numpy as np
 
-__all__ = ["SCORE_LIMIT", "check_magnitude", "overflow_limit"]
+__all__ = ["SCORE_LIMIT", "check_magnitude", "check_stacked_magnitude", "overflow_limit"]
 
 #: Standardised deviations past which a generation log-probability is not reliable.
 SCORE_LIMIT = 1e5
@@ -58,7 +58,6 @@ def check_magnitude(clips, estimator, *, center=0.0, scale=1.0, limit=None, why=
     ValueError: X: clip 1, channel 1 holds 1e+300; MotionTreeEncoder sums squares of the values, which overflow float64 past 1.5e+153: rescale the data (check its units).
     """  # noqa: E501
     limit = overflow_limit(clips) if limit is None else limit
-    why = why or f"sums squares of the values, which overflow float64 past {limit:.3g}"
     for i, clip in enumerate(clips):
         if not clip.size:
             continue
@@ -71,11 +70,77 @@ def check_magnitude(clips, estimator, *, center=0.0, scale=1.0, limit=None, why=
             worst = np.maximum(high, np.abs(clip.min(axis=0) - center_i)) / scale_i
         bad = np.flatnonzero(~(worst <= limit))
         if bad.size:
-            j = int(bad[0])
-            with np.errstate(over="ignore", invalid="ignore"):
-                reach = np.abs((clip[:, j] - center_i[j]) / scale_i[j])
-            value = clip[np.argmax(reach), j]
-            raise ValueError(
-                f"X: clip {i}, channel {j} holds {value:.3g}; {type(estimator).__name__} "
-                f"{why}: rescale the data (check its units)."
-            )
+            _refuse(clip, i, int(bad[0]), center_i, scale_i, estimator, limit, why)
+
+
+def check_stacked_magnitude(frames, offsets, estimator, checks):
+    """:func:`check_magnitude` of stacked clips under several ``(center, scale, why)``
+    checks in turn, from one maximum and minimum of each clip's channels.
+
+    The same limit (:func:`overflow_limit` of the frames), the same first clip and
+    channel named, the same message as :func:`check_magnitude` called once per check;
+    the extremes are two reductions over all clips (``reduceat``), not two per clip and
+    check, so a call costs about as much for one clip as for a batch's share of one.
+
+    Parameters
+    ----------
+    frames : ndarray of shape (n_frames, n_channels)
+        Finite stacked clips (``stack_clips``).
+    offsets : ndarray of shape (n_clips + 1,)
+        Clip ``i`` is ``frames[offsets[i]:offsets[i + 1]]``.
+    estimator : estimator
+        Named in the message.
+    checks : sequence of (center, scale, why)
+        As the arguments of :func:`check_magnitude` (``why`` None for its default).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree._magnitude import check_stacked_magnitude
+    >>> from skmotion.tree import MotionTreeEncoder
+    >>> frames, offsets = np.array([[0.0, 1.0], [0.0, 1e300]]), np.array([0, 1, 2])
+    >>> check_stacked_magnitude(frames, offsets, MotionTreeEncoder(), [(0.0, 1.0, None)])
+    Traceback (most recent call last):
+    ...
+    ValueError: X: clip 1, channel 1 holds 1e+300; MotionTreeEncoder sums squares of the values, which overflow float64 past 3.35e+153: rescale the data (check its units).
+    """  # noqa: E501
+    if not frames.size:
+        return
+    limit = float(np.sqrt(np.finfo(np.float64).max / (4.0 * frames.size)))
+    # all frames' extremes first (fast contiguous reductions): when they pass, every clip's
+    # do (|x - c| / s grows with |x - c|, also in rounding); only else each clip's
+    high, low = np.maximum.reduce(frames, axis=0), np.minimum.reduce(frames, axis=0)
+    with np.errstate(over="ignore", invalid="ignore"):
+        if all((_reach(high, low, center, scale) <= limit).all() for center, scale, _ in checks):
+            return
+    clip = np.flatnonzero(offsets[1:] > offsets[:-1])  # reduceat needs non-empty clips
+    starts = offsets[clip]
+    high, low = np.maximum.reduceat(frames, starts), np.minimum.reduceat(frames, starts)
+    for center, scale, why in checks:
+        with np.errstate(over="ignore", invalid="ignore"):
+            worst = _reach(high, low, center, scale)
+        bad = np.argwhere(~(worst <= limit))  # row-major: the first clip, then its channel
+        if len(bad):
+            row, j = int(bad[0, 0]), int(bad[0, 1])
+            i = int(clip[row])
+            rows = frames[offsets[i] : offsets[i + 1]]
+            center_i = np.broadcast_to(center, rows.shape[1:])
+            scale_i = np.broadcast_to(scale, rows.shape[1:])
+            _refuse(rows, i, j, center_i, scale_i, estimator, limit, why)
+
+
+def _reach(high, low, center, scale):
+    """``|x - center| / scale`` at its largest over values between ``low`` and ``high``."""
+    return np.maximum(np.abs(high - center), np.abs(low - center)) / scale
+
+
+def _refuse(clip, i, j, center, scale, estimator, limit, why):
+    """The ValueError naming clip ``i``'s channel ``j`` and its farthest value."""
+    why = why or f"sums squares of the values, which overflow float64 past {limit:.3g}"
+    with np.errstate(over="ignore", invalid="ignore"):
+        reach = np.abs((clip[:, j] - center[j]) / scale[j])
+    value = clip[np.argmax(reach), j]
+    raise ValueError(
+        f"X: clip {i}, channel {j} holds {value:.3g}; {type(estimator).__name__} "
+        f"{why}: rescale the data (check its units)."
+    )

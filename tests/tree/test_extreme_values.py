@@ -11,7 +11,13 @@ from hypothesis import strategies as st
 
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTreeEncoder, MotionTreeHMM
-from skmotion.tree._magnitude import SCORE_LIMIT, overflow_limit
+from skmotion.tree._magnitude import (
+    SCORE_LIMIT,
+    check_magnitude,
+    check_stacked_magnitude,
+    overflow_limit,
+)
+from skmotion.utils import stack_clips
 
 
 @pytest.fixture(scope="module")
@@ -116,3 +122,38 @@ def test_encoder_features_are_finite_below_the_overflow_limit(encoder, data, exp
         encoder.moment_scale_[channel]
     )
     np.testing.assert_allclose(features[k, column], expected, rtol=1e-9)
+
+
+@given(
+    lengths=st.lists(st.integers(0, 4), min_size=1, max_size=5),
+    where=st.integers(0, 10**6),
+    value=st.sampled_from([1e300, -1e300, 1e200, 3.0]),
+    spread=st.sampled_from([1.0, 1e-160]),  # 1e-160: the second check fails
+)
+@settings(max_examples=60, deadline=None)
+def test_the_stacked_check_names_what_the_per_clip_checks_name(lengths, where, value, spread):
+    """One check of stacked clips under two limits = check_magnitude per limit, in turn:
+    the same clip, channel and message (or none), empty clips included."""
+    rng = np.random.default_rng(where)
+    clips = [rng.normal(size=(n, 3)) for n in lengths]
+    frames, offsets = stack_clips(clips)
+    if len(frames):
+        frames[where % len(frames), where % 3] = value
+        clips = [frames[a:b] for a, b in zip(offsets[:-1], offsets[1:])]
+    center, scale = np.array([0.5, -1.0, 0.0]), np.array([1.0, spread, 2.0])
+    estimator = MotionTreeEncoder()
+
+    def message(call):
+        try:
+            call()
+        except ValueError as error:
+            return str(error)
+        return None
+
+    def per_clip():
+        check_magnitude(clips, estimator)
+        check_magnitude(clips, estimator, center=center, scale=scale, why="in spreads")
+
+    checks = [(0.0, 1.0, None), (center, scale, "in spreads")]
+    stacked = message(lambda: check_stacked_magnitude(frames, offsets, estimator, checks))
+    assert stacked == message(per_clip)

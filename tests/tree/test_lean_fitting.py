@@ -128,7 +128,7 @@ def test_a_router_pickled_without_its_tables_routes_the_same():
     tree = MotionTree.build(frames, max_depth=7, split="median")
     router = TreeRouter(tree, frames.mean(axis=0), frames.std(axis=0))
     state = dict(router.__dict__)
-    for name in ("left_or_self", "right_or_self", "in_product", "_products"):
+    for name in ("left_or_self", "right_or_self", "in_product", "walkable", "_products"):
         del state[name]
     old = TreeRouter.__new__(TreeRouter)
     old.__setstate__(state)

@@ -195,7 +195,15 @@ class _Builder:
 
 
 def build_nodes(
-    X, *, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar, copy=True
+    X,
+    *,
+    max_depth,
+    min_samples_split,
+    min_samples_leaf,
+    split,
+    covariance_type,
+    reg_covar,
+    copy=True,
 ):
     """Grow the tree over validated frames; the per-node arrays and the layers.
 

@@ -190,7 +190,8 @@ def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
     # frames costs as much as the sums themselves
     centred = np.subtract(frames, center)
     blocks = [
-        _cell_means(centred, clip, lengths, parts) / np.tile(scale, parts) for parts in pyramid
+        _cell_means(centred, clip, lengths, parts) / (np.tile(scale, parts) if parts > 1 else scale)
+        for parts in pyramid
     ]
     if order >= 2:
         np.square(centred, out=centred)

@@ -11,6 +11,8 @@ axis (a product would do work for every node).
 
 import numpy as np
 
+from skmotion.tree._encoding._walk import walk_layers
+
 __all__ = ["TreeRouter"]
 
 # Split nodes of a layer up to which all frames are projected on all of its axes at once:
@@ -68,11 +70,15 @@ class TreeRouter:
         self.right_or_self = np.where(self.right >= 0, self.right, own)
         # layers whose split axes go into the one product (see _route_block)
         self.in_product = np.array([0 < len(ids) <= _DENSE_LIMIT for ids in self.split_ids])
+        # layers walked through the product's columns: those in it, and those without splits
+        self.walkable = np.array([len(ids) <= _DENSE_LIMIT for ids in self.split_ids], np.uint8)
+        self.layer_index = np.ascontiguousarray(self.layer_index, dtype=np.intp)
+        self.threshold = np.ascontiguousarray(self.threshold, dtype=np.float64)
         self._products = {}  # per deepest layer routed: the product's axes, each node's column
 
     def __setstate__(self, state):
         self.__dict__.update(state)
-        if "_products" not in state:  # pickled by a version whose router had no tables
+        if not {"walkable", "_products"} <= state.keys():  # pickled without (all) its tables
             self._derive()
 
     def route(self, frames, layers=None):
@@ -91,7 +97,9 @@ class TreeRouter:
             ``nodes[i, j]`` is the layer index of frame ``i``'s node in ``layers[j]``.
         """
         frames = np.asarray(frames, dtype=np.float64)
-        layers = np.arange(self.n_layers) if layers is None else np.asarray(layers, np.intp)
+        layers = (
+            np.arange(self.n_layers) if layers is None else np.ascontiguousarray(layers, np.intp)
+        )
         if len(frames) <= _CHUNK:
             return self._route_block(frames, layers)
         out = np.empty((len(frames), len(layers)), dtype=np.intp)
@@ -106,23 +114,19 @@ class TreeRouter:
         axes, column = self._product(int(layers[-1]))
         # einsum, not BLAS: a product this thin gains nothing from BLAS's threads, and on a
         # busy machine their hand-offs cost 50-100x the arithmetic (measured).
-        proj = np.einsum("ij,kj->ik", frames, axes) if len(axes) else None
-        rows = np.arange(len(frames))
-        k = 0
-        for layer in range(layers[-1] + 1):
-            if layer == layers[k]:
-                out[:, k] = self.layer_index[layer, node]
-                k += 1
+        proj = np.einsum("ij,kj->ik", frames, axes) if len(axes) else np.zeros((len(frames), 0))
+        layer, k = 0, 0
+        while True:
+            # the layers whose axes are in the product (a leaf's column is -1: both of its
+            # sides are itself), walked in one compiled loop; a deeper layer is one _step
+            layer, k = walk_layers(
+                proj, column, self.threshold, self.left_or_self, self.right_or_self,
+                self.layer_index, self.walkable, layers, node, out, layer, k,
+            )  # fmt: skip
             if layer == layers[-1]:
-                break
-            if proj is not None and self.in_product[layer]:
-                # this layer's axes are in the product (a leaf's column is -1: any value,
-                # since both of its sides are itself)
-                right = proj[rows, column[node]] > self.threshold[node]
-                node = np.where(right, self.right_or_self[node], self.left_or_self[node])
-            else:
-                node = self._step(frames, node)
-        return out
+                return out
+            node = self._step(frames, node)
+            layer += 1
 
     def _product(self, last):
         """The split axes of the upper layers above ``last`` (few nodes each), applied to all
