@@ -420,7 +420,7 @@ def figure_labelling(take, truth, path, plain, path_file):
     ax.set_yticks(range(len(names)), names)
     ax.set_xlabel("time (s)")
     ax.set_title("frame labels of four held-out MSRC-12 takes end to end", fontsize=10)
-    ax.legend(loc="upper right", fontsize=7, markerscale=6)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=3, fontsize=8, markerscale=6)
     fig.tight_layout()
     path_file.parent.mkdir(exist_ok=True)
     fig.savefig(path_file, dpi=100)
