@@ -31,7 +31,7 @@ LABELLING_FIGURE = FIGURE.with_name("live_labelling.png")
 LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
 THRESHOLDS = np.r_[np.round(np.linspace(0.05, 0.95, 19), 2), 0.97, 0.99]
 REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
-LINEAR_C = (0.01, 0.1)  # LinearGestureDetector's C, chosen by the same GroupKFold
+LINEAR_C = (0.1,)  # LinearGestureDetector's C grid (chosen by the same GroupKFold when longer)
 GESTURES = (
     "lift arms", "duck", "push right", "goggles", "wind it up", "shoot",
     "bow", "throw", "had enough", "change weapon", "beat both", "kick",
@@ -179,8 +179,16 @@ def detectors(step, window, chosen=None):
         for name, recogniser in recognisers().items()
     }
     # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size)
+    # negatives: 80 windows per take ending anywhere more than `jitter` (1) frame from an
+    # action point, so that the score peaks at the completion and not before or after it
     found[LINEAR] = LinearGestureDetector(
-        n_segments=5, segment=window // 5, root=0, size_joints=(0, 2), random_state=0
+        n_segments=5,
+        segment=window // 5,
+        root=0,
+        size_joints=(0, 2),
+        n_negatives=80,
+        negative_gap=0,
+        random_state=0,
     )
     if chosen:
         found = {k: v for k, v in found.items() if any(c.lower() in k.lower() for c in chosen)}
