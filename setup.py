@@ -102,6 +102,12 @@ live_window = Extension(
     ["skmotion/live/_window_kernel.pyx"],
     extra_compile_args=["-O3"],
 )
+# The best label path of a long take under a switch penalty (live/_segmenter.py).
+live_path = Extension(
+    "skmotion.live._switch_path",
+    ["skmotion/live/_switch_path.pyx"],
+    extra_compile_args=["-O3"],
+)
 setup(
     ext_modules=cythonize(
         [
@@ -115,6 +121,7 @@ setup(
             permute,
             walk,
             live_window,
+            live_path,
         ]
     )
 )

@@ -103,13 +103,15 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         loss ends (``"fall"``) an event.
     refractory : int, default=15
         The fewest frames between two events.
-    trigger : {"fall", "rise"}, default="fall"
+    trigger : {"fall", "peak", "rise"}, default="fall"
         ``"rise"``: an event at the first window whose score reaches
         ``threshold``; ``"fall"``: when the score falls back below it after
         a run at or above it, with the run's best motion and score (a window
         stops matching once its motion is over: the fall marks the
         completion, where a recogniser that knows a motion early rises long
-        before it).
+        before it); ``"peak"``: in such a run, at the first window whose
+        score is below the run's best so far (one window after the peak; at
+        the run's end if it never turns down), once per run.
     n_negatives : int, default=20
         Windows ending away from action points drawn per training take.
     negative_gap : int, default=3

@@ -2,7 +2,7 @@
 
 A detector scores a window every ``step`` frames: one probability per class,
 the "nothing known" class among them; a window's *score* is its best
-motion's probability. Two triggers turn scores into events:
+motion's probability. Three triggers turn scores into events:
 
 - ``"rise"``: an event at the first window whose score reaches
   ``threshold`` (the earliest answer; a recogniser that knows a motion before
@@ -11,7 +11,13 @@ motion's probability. Two triggers turn scores into events:
   run of windows at or above it, labelled with the run's best motion and
   score. A window that ends as a motion completes stops matching once the
   motion is over, so the fall marks the completion; a higher threshold
-  fires sooner (the score drops below it earlier).
+  fires sooner (the score drops below it earlier);
+- ``"peak"``: in a run of windows at or above ``threshold``, an event at
+  the first window whose score is below the run's best so far (the score
+  has peaked one window before), labelled with the run's best motion and
+  score; a run that never turns down fires as ``"fall"``, at its end. One
+  event per run at most. For a recogniser whose score peaks as a motion
+  completes: the event comes one window after the peak.
 
 In both, an event needs ``refractory`` frames since the last one. The
 threshold trades misses for false alarms and, with the trigger, latency.
@@ -25,7 +31,7 @@ import numpy as np
 
 __all__ = ["Event", "TRIGGERS", "TriggerState", "gesture_scores", "next_events"]
 
-TRIGGERS = ("fall", "rise")
+TRIGGERS = ("fall", "peak", "rise")
 
 
 class Event(NamedTuple):
@@ -41,7 +47,8 @@ class TriggerState(NamedTuple):
 
     ``last``: the frame of the last event (None: none yet); ``run_best`` and
     ``run_score``: the best motion's column and score in the current run of
-    windows at or above the threshold (``run_best`` None: no run).
+    windows at or above the threshold (``run_best`` None: no run; ``run_score``
+    infinite: the ``"peak"`` trigger has fired in this run).
     """
 
     last: object = None
@@ -75,7 +82,7 @@ def next_events(ends, proba, classes, none_index, *, threshold, refractory, trig
         The score that starts (``"rise"``) or whose loss ends (``"fall"``) an event.
     refractory : int
         The fewest frames between two events.
-    trigger : {"fall", "rise"}
+    trigger : {"fall", "peak", "rise"}
     state : TriggerState
         The state after the previous windows (``TriggerState()`` at the start).
 
@@ -96,6 +103,8 @@ def next_events(ends, proba, classes, none_index, *, threshold, refractory, trig
                 events.append(Event(frame, classes[best[i]], float(score[i])))
                 last = frame
         return events, TriggerState(last, None, -np.inf)
+    if trigger == "peak":
+        return _peak_events(ends, best, score, above, classes, refractory, state)
     # "fall": walk the runs of windows above the threshold, one event at each run's end
     flips = np.flatnonzero(np.diff(np.r_[run_best is not None, above].astype(np.int8)))
     start = 0 if run_best is not None else None
@@ -115,4 +124,35 @@ def next_events(ends, proba, classes, none_index, *, threshold, refractory, trig
         top = start + int(np.argmax(score[start:]))
         if score[top] > run_score or run_best is None:
             run_best, run_score = best[top], float(score[top])
+    return events, TriggerState(last, run_best, run_score)
+
+
+def _peak_events(ends, best, score, above, classes, refractory, state):
+    """The ``"peak"`` trigger: :func:`next_events` on windows with their best motions and scores.
+
+    Only the windows at or above the threshold and the first one below after
+    each run can change anything: a loop over those, not over every window.
+    """
+    last, run_best, run_score = state
+    was_above = np.r_[run_best is not None, above[:-1]]
+    events = []
+
+    def emit(i, column, value):
+        nonlocal last
+        frame = int(ends[i])
+        if last is None or frame - last >= refractory:
+            events.append(Event(frame, classes[column], float(value)))
+            last = frame
+
+    for i in np.flatnonzero(above | was_above):
+        fired = run_score == np.inf
+        if not above[i]:  # the run is over: it fires at its end unless it fired at a peak
+            if run_best is not None and not fired:
+                emit(i, run_best, run_score)
+            run_best, run_score = None, -np.inf
+        elif run_best is None or (not fired and score[i] > run_score):
+            run_best, run_score = best[i], float(score[i])  # a run starts, or climbs
+        elif not fired and score[i] < run_score:  # it turns down: the peak was before
+            emit(i, run_best, run_score)
+            run_score = np.inf
     return events, TriggerState(last, run_best, run_score)

@@ -83,7 +83,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         loss ends (``"fall"``) an event.
     refractory : int, default=15
         The fewest frames between two events.
-    trigger : {"fall", "rise"}, default="fall"
+    trigger : {"fall", "peak", "rise"}, default="fall"
         As for :class:`GestureDetector`.
     jitter : int, default=1
         Positive windows also end this many frames before and after each action point.
@@ -360,6 +360,7 @@ class LinearDetectorStream:
         self._classes, self._none = d.classes_, d.none_index_
         self._rule = dict(threshold=d.threshold, refractory=d.refractory, trigger=d.trigger)
         self._threshold, self._fall = d.threshold, d.trigger == "fall"
+        self._runs = d.trigger in ("fall", "peak")  # the triggers that follow runs of windows
         n_classes = len(d.classes_)
         self._ring = np.zeros((d.window, d.n_segments, n_classes))
         self._previous = np.zeros(d.n_features_in_)
@@ -413,10 +414,14 @@ class LinearDetectorStream:
             # the two cases in which next_events would emit nothing, said in scalars
             if state.run_best is None and top < self._threshold:
                 return []  # below the threshold and no run open: nothing changes
-            if self._fall and state.run_best is not None and top >= self._threshold:
+            if self._runs and state.run_best is not None and top >= self._threshold:
+                if state.run_score == np.inf:  # "peak" has fired in this run: nothing until it ends
+                    return []
                 if top > state.run_score:  # a run goes on: it keeps its best motion
                     self._state = state._replace(run_best=best[0], run_score=top)
-                return []
+                    return []
+                if self._fall or top == state.run_score:
+                    return []
             start = self.n_frames - 1
         else:
             if frames.ndim != 2 or frames.shape[1] != width:

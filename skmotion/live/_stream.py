@@ -28,7 +28,7 @@ class DetectorStream:
     none_index : int
     threshold : float
     refractory : int
-    trigger : {"fall", "rise"}, default="fall"
+    trigger : {"fall", "peak", "rise"}, default="fall"
 
     Attributes
     ----------

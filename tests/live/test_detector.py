@@ -155,6 +155,21 @@ def test_the_fall_trigger_by_hand(rng):
     assert [e.frame for e in detector.detect([take])[0]] == [6]
 
 
+def test_the_peak_trigger_by_hand(rng):
+    # windows end at frames 2, 3, ..., 13; runs at or above 0.5: windows 1-3, 5-8 and 10-11
+    scores = [0.1, 0.6, 0.9, 0.7, 0.2, 0.5, 0.5, 0.8, 0.8, 0.3, 0.6, 0.7]
+    take = rng.normal(size=(14, 1))
+    detector = GestureDetector(Scripted(scores), window=3, step=1, refractory=0, trigger="peak")
+    detector.fit([take], ["g"], action_points=[[5]])
+    events = detector.detect([take])[0]
+    # run 1 turns down at window 3 (frame 5); run 2 never turns down (equal scores do not
+    # count), so it fires at its end (frame 11); run 3 climbs to its end (frame 13 is the
+    # take's last window: still open, no event)
+    assert [(e.frame, e.score) for e in events] == [(5, 0.9), (11, 0.8)]
+    detector.set_params(refractory=7)  # the second comes 6 frames after the first: dropped
+    assert [e.frame for e in detector.detect([take])[0]] == [5]
+
+
 def test_a_recogniser_with_decision_function_only_and_a_prefitted_one(planted):
     _, takes, points, labels = planted
     svm = make_pipeline(MotionTreeEncoder(max_depth=3), LinearSVC())  # no predict_proba

@@ -5,9 +5,11 @@ import sys
 
 import numpy as np
 import pytest
+from sklearn.base import clone
 
 from skmotion.estimator_checks import ClipCase, parametrize_with_clip_checks
 from skmotion.live import LinearGestureDetector
+from skmotion.live._events import TriggerState, next_events
 from skmotion.live._linear_detector import segment_means
 from skmotion.metrics import detection_f1
 from tests.conftest import SHARED_DATA
@@ -101,6 +103,28 @@ def test_the_stream_equals_the_batch_to_the_bit(fitted, skeleton_takes, chunk):
     stream.reset()
     assert [e for frame in take for e in stream.update(frame)] == batch
     assert stream.update(take[:0]) == [] and stream.n_frames == len(take)  # an empty chunk
+
+
+@pytest.mark.parametrize("trigger", ["fall", "peak", "rise"])
+@pytest.mark.parametrize("threshold", [0.2, 0.6])
+def test_every_trigger_streams_the_batch_events(fitted, skeleton_takes, trigger, threshold):
+    detector = clone(fitted).set_params(trigger=trigger, threshold=threshold, refractory=4)
+    takes, points, labels = skeleton_takes
+    detector.fit(takes[:4], labels[:4], action_points=points[:4])
+    take = np.concatenate(takes[4:])
+    (batch,) = detector.detect([take])
+    assert len(batch) >= 5
+    for chunk in (1, 5):
+        stream = detector.stream()
+        assert [
+            e for s in range(0, len(take), chunk) for e in stream.update(take[s : s + chunk])
+        ] == batch
+    ((ends, proba),) = detector.scores([take])
+    expected = next_events(
+        ends, proba, detector.classes_, detector.none_index_, threshold=threshold,
+        refractory=4, trigger=trigger, state=TriggerState(),
+    )[0]  # fmt: skip
+    assert batch == expected
 
 
 def test_the_stream_memory_does_not_grow(fitted, skeleton_takes):

@@ -6,7 +6,7 @@ import pytest
 from skmotion.datasets import make_motions
 from skmotion.estimator_checks import ClipCase, parametrize_with_clip_checks
 from skmotion.live import ActivitySegmenter
-from skmotion.live._segmenter import _covering_mean, runs
+from skmotion.live._segmenter import _covering_mean, path_labels, runs, switch_path
 
 
 def concatenated(X, y, idx, seed):
@@ -90,3 +90,56 @@ def motion_clips():
 )
 def test_conformance(check):
     check()
+
+
+def _path_value(score, path, penalty):
+    path = np.asarray(path)
+    return score[np.arange(len(path)), path].sum() - penalty * np.count_nonzero(np.diff(path))
+
+
+def test_switch_path_is_the_best_path_of_all(rng):
+    # brute force over every path of small trellises
+    import itertools
+
+    for _ in range(200):
+        n, k = rng.integers(1, 7), rng.integers(1, 4)
+        score, penalty = rng.normal(size=(n, k)), rng.uniform(0, 2)
+        best = max(_path_value(score, p, penalty) for p in itertools.product(range(k), repeat=n))
+        got = switch_path(score, penalty)
+        assert got.dtype == np.intp and got.shape == (n,)
+        assert _path_value(score, got, penalty) == pytest.approx(best, abs=1e-12)
+
+
+def test_switch_path_by_hand():
+    # one frame favours "b" by 1: worth a detour when two switches cost less than 1
+    score = np.log([[0.9, 0.1], [0.9, 0.1], [0.2, 0.8], [0.9, 0.1]])
+    gain = np.log(0.8) - np.log(0.2)  # 1.386: what "b" at frame 2 gains
+    assert switch_path(score, 0.0).tolist() == [0, 0, 1, 0]
+    assert switch_path(score, gain / 2 - 0.01).tolist() == [0, 0, 1, 0]
+    assert switch_path(score, gain / 2 + 0.01).tolist() == [0, 0, 0, 0]
+    assert switch_path(np.zeros((0, 3)), 1.0).tolist() == []
+
+
+def test_switch_penalty_removes_short_flips_and_keeps_long_segments():
+    classes = np.array(["a", "b"], dtype=object)
+    proba = np.full((100, 2), [0.7, 0.3])
+    proba[50:] = [0.2, 0.8]  # a long "b" segment
+    proba[20:23] = [0.4, 0.6]  # a short, weak flip to "b" inside "a"
+    plain = path_labels(proba, classes, switch_penalty=0, threshold=0, none_label="-")
+    assert [(s, e, c) for s, e, c in runs(plain)] == [
+        (0, 20, "a"), (20, 23, "b"), (23, 50, "a"), (50, 100, "b")
+    ]  # fmt: skip
+    # the flip gains 3 * log(0.6 / 0.4) = 1.2 against two switches
+    smooth = path_labels(proba, classes, switch_penalty=1.0, threshold=0, none_label="-")
+    assert runs(smooth) == [(0, 50, "a"), (50, 100, "b")]
+    # a label below the threshold is nothing known
+    low = path_labels(proba, classes, switch_penalty=1.0, threshold=0.75, none_label="-")
+    assert runs(low) == [(0, 50, "-"), (50, 100, "b")]
+
+
+def test_switch_penalty_in_predict_frames_labels_a_noisy_take(rng):
+    low, high = rng.normal(0, 0.1, (300, 2)), rng.normal(1, 0.1, (300, 2))
+    model = ActivitySegmenter(window=10, step=2, switch_penalty=5.0).fit([low, high], ["lo", "hi"])
+    take = np.concatenate([low[:120], high[:120]])
+    take[50:53] = 1.0  # a blip of "hi" inside "lo": three frames, less than a window
+    assert model.segments([take])[0] == [(0, 120, "lo"), (120, 240, "hi")]
