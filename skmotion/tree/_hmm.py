@@ -72,12 +72,16 @@ class MotionTreeHMM(ClipFeatureMixin, ClassifierMixin, BaseEstimator):
 
     Parameters
     ----------
-    max_depth : int, default=8
+    max_depth : int, default=12
         The deepest layer of the tree (the root is layer 0); None for no limit
-        (the paper's choice). Decoding costs one pass per layer.
+        (the paper's choice). Decoding costs one pass per layer. Deep trees
+        recognise people never seen in training best: on MSRC-12 (grouped
+        cross-validation over the training people) depth 6, 8, 10 and 12
+        reached 0.66, 0.79, 0.83 and 0.84, and 0.85 at depth 12 with
+        ``min_samples_leaf=8`` (the user guide's "The measured defaults").
     min_samples_split : int, default=2
         A node with fewer frames is not split.
-    min_samples_leaf : int, default=4
+    min_samples_leaf : int, default=8
         A split is only made when both sides keep this many frames (the
         paper's databases use 16).
     split : {"two_means", "median", "min_error"}, default="two_means"
