@@ -31,16 +31,15 @@ from skmotion.preprocessing import VirtualMarkerTransform
 from skmotion.tree import MotionTreeHMM
 
 CANDIDATES = {  # name -> MotionTreeHMM parameters changed from today's defaults
-    "defaults": {},
-    "former defaults (depth 8, smoothing 1)": {"max_depth": 8, "smoothing": 1.0},
-    "depth 8": {"max_depth": 8},
-    "depth 12": {"max_depth": 12},
-    "smoothing 1": {"smoothing": 1.0},
-    "smoothing 100": {"smoothing": 100.0},
-    "n_paths 1": {"n_paths": 1},
+    "defaults (depth 12, leaf 8, smoothing 1)": {},
+    "former defaults (depth 8, leaf 4)": {"max_depth": 8, "min_samples_leaf": 4},
+    "depth 10": {"max_depth": 10},
+    "depth 14": {"max_depth": 14},
+    "leaf 4": {"min_samples_leaf": 4},
+    "leaf 16": {"min_samples_leaf": 16},
+    "smoothing 10": {"smoothing": 10.0},
     "n_paths 5": {"n_paths": 5},
     "median splits": {"split": "median"},
-    "min_samples_leaf 16": {"min_samples_leaf": 16},
 }
 
 
