@@ -37,11 +37,11 @@ class TreeParams:
 
     Parameters
     ----------
-    max_depth : int or None, default=8
+    max_depth : int or None, default=12
         The deepest layer (the root is layer 0); None for no limit.
     min_samples_split : int, default=2
         A node with fewer frames is not split.
-    min_samples_leaf : int, default=4
+    min_samples_leaf : int, default=8
         A split is only made when both sides keep this many frames.
     split : {"two_means", "median", "min_error"}, default="two_means"
         How a node's projections on its first principal axis are cut
@@ -62,9 +62,9 @@ class TreeParams:
     ValueError: min_samples_leaf must be an int >= 1...
     """
 
-    max_depth: int | None = 8
+    max_depth: int | None = 12
     min_samples_split: int = 2
-    min_samples_leaf: int = 4
+    min_samples_leaf: int = 8
     split: str = "two_means"
     covariance_type: str = "diag"
     reg_covar: float = 1e-6
