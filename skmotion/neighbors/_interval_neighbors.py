@@ -45,8 +45,10 @@ _LEAVES_PER_TASK = 32
 _DEFAULT_LEVELS = 7
 # The recall the entry widths are learned for when neither rule is given.
 _DEFAULT_RECALL = 0.99
-# Feature components the discriminant axes are learned from (at most what the data allows).
-_DISCRIMINANT_INPUTS = 20
+# Feature components the discriminant axes are learned from (at most what the data allows):
+# on MSRC-12's development people, 20, 40 and 60 (all) components gave held-out pruning
+# 0.92, 0.94 and 0.95 at recall 0.96 (benchmarks/bench_neighbors_msrc12.py).
+_DISCRIMINANT_INPUTS = 64
 
 
 class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -108,14 +110,15 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
     axes : {"svd", "discriminant"}, default="svd"
         What the tree's levels index. ``"svd"``: the leading feature
         components (the paper). ``"discriminant"``: the leading discriminant
-        axes of the first 20 feature components (fewer when the data allows
-        fewer), learned from ``y``: Fisher's discriminant, between-label over
-        within-label variance, with the within-label covariance shrunk by
-        Ledoit-Wolf (sklearn's ``LinearDiscriminantAnalysis(solver="eigen",
+        axes of the first 64 feature components (all the data allows when
+        fewer: 60 for 60-channel clips with the first vector), learned from
+        ``y``: Fisher's discriminant, between-label over within-label
+        variance, with the within-label covariance shrunk by Ledoit-Wolf
+        (sklearn's ``LinearDiscriminantAnalysis(solver="eigen",
         shrinkage="auto")``). Levels then spread the labels apart and the
         widths cover the within-label spread only: on MSRC-12 repetitions
         (similar = same gesture by the same person) this raises the held-out
-        pruning at recall 0.95 from about 0.8 to over 0.9. It needs
+        pruning at recall 0.95 from about 0.8 to 0.9 or more. It needs
         labels that are repetitions with several clips each: with few clips
         per label the axes fit the training clips' spread and held-out recall
         falls (see the user guide). The ranking (psi, or Euclidean on the
@@ -347,7 +350,7 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         return inputs[:, : len(axes)] @ axes
 
     def _n_inputs(self, limit):
-        """Feature components (or columns) read: ``n_levels_``, or up to 20 for the axes."""
+        """Feature components (or columns) read: ``n_levels_``, or up to 64 for the axes."""
         if self.axes == "svd":
             return self.n_levels_
         return max(self.n_levels_, min(limit, _DISCRIMINANT_INPUTS))
