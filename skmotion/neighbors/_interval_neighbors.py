@@ -164,7 +164,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
         The fitted feature projection (None for feature-vector input); with
         ``axes="discriminant"`` it has the ``n_inputs`` components the axes read.
     feature_extractor_ : SVDFeatureExtractor or None
-        An extractor applying ``projection_`` (None for feature-vector input).
+        An extractor applying ``projection_`` (None for feature-vector input):
+        the SVD feature vectors, whose first ``n_levels_`` components the tree
+        indexes (or, with ``axes="discriminant"``, their product with ``axes_``).
     input_kind_ : {"clips", "table"}
         What fit was given.
     effective_metric_ : {"psi", "euclidean"}
