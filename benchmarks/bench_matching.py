@@ -178,16 +178,27 @@ def frame_search(name, matcher_kw, index_takes, query_takes, n_queries):
 
 
 def _brute_top(query, take, k, exclusion):
-    """Top-k z-normalised windows by explicit z-normalisation, greedy exclusion (chunks)."""
+    """Top-k z-normalised windows by explicit z-normalisation, greedy exclusion (chunks).
+
+    A constant channel (spread 0) has no z-normalised form: as in stumpy and
+    find_occurrences, it is at 0 from a constant channel and sqrt(m) from any other.
+    """
     m = len(query)
-    q = (query - query.mean(0)) / query.std(0)
+    q_flat = (query == query[:1]).all(axis=0)
+    q = (query - query.mean(0)) / np.where(q_flat, 1.0, query.std(0))
     profile = np.empty(len(take) - m + 1)
     for start in range(0, len(profile), 20000):
         stop = min(start + 20000, len(profile))
         w = np.lib.stride_tricks.sliding_window_view(take[start : stop + m - 1], m, axis=0)
         w = w.transpose(0, 2, 1)  # (windows, m, channels)
-        z = (w - w.mean(axis=1, keepdims=True)) / w.std(axis=1, keepdims=True)
-        profile[start:stop] = np.sqrt(((z - q) ** 2).sum(axis=1)).mean(axis=1)
+        # Constant exactly (a computed spread of equal values may round to 1e-17).
+        flat = (w == w[:, :1, :]).all(axis=1)  # (windows, channels)
+        spread = np.where(flat[:, None, :], 1.0, w.std(axis=1, keepdims=True))
+        z = (w - w.mean(axis=1, keepdims=True)) / spread
+        per_channel = np.sqrt(((z - q) ** 2).sum(axis=1))  # (windows, channels)
+        per_channel = np.where(flat & q_flat, 0.0, per_channel)
+        per_channel = np.where(flat ^ q_flat, np.sqrt(m), per_channel)
+        profile[start:stop] = per_channel.mean(axis=1)
     found = []
     while len(found) < k:
         i = int(np.argmin(profile))

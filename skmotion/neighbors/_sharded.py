@@ -119,7 +119,8 @@ class ShardedIntervalIndex:
     ----------
     estimator : IntervalIndexNeighbors, default=None
         The parameters (cloned); ``similar="psi"`` is not supported (it would
-        compare every pair of clips across shards). None means the defaults.
+        compare every pair of clips across shards), nor ``axes="discriminant"``.
+        None means the defaults.
     client : distributed.Client
         The Dask client whose workers hold the shards.
     n_shards : int, default=None
@@ -150,6 +151,8 @@ class ShardedIntervalIndex:
         layout = clone(IntervalIndexNeighbors() if self.estimator is None else self.estimator)
         if layout.similar == "psi":
             raise ValueError('ShardedIntervalIndex supports similar="labels" only.')
+        if layout.axes != "svd":
+            raise ValueError('ShardedIntervalIndex supports axes="svd" only.')
         clips = check_clips(X, estimator=layout, reset=True)
         y = layout._check_labels(y, len(clips))
         weighting = layout._weighting()
