@@ -307,6 +307,8 @@ def figure(detectors, take, points, gesture, path):
 
 
 SWITCH_PENALTIES = (0.0, 10.0, 30.0, 100.0, 300.0, 1000.0, 3000.0)  # ActivitySegmenter's grid
+# the recogniser's defaults, and the standardised columns it had before its defaults study
+RECOGNISER_GRID = ({}, {"recognizer__column_power": 1.0, "recognizer__C": 0.1})
 
 
 def concatenated_takes(takes, gestures, people, idx, seed=0):
@@ -334,19 +336,23 @@ def _path_accuracy(probas, truth, classes, penalty):
 
 
 def _choose_penalty(segmenter, takes, gestures, people, train):
-    """The switch penalty of the best frame accuracy on out-of-fold concatenated takes of the
-    training people (GroupKFold(3) over them): the test people never enter the choice."""
-    hits = np.zeros(len(SWITCH_PENALTIES))
+    """The recogniser's setting (of RECOGNISER_GRID) and the switch penalty of the best frame
+    accuracy on out-of-fold concatenated takes of the training people (GroupKFold(3) over
+    them): the test people never enter the choice."""
+    hits = np.zeros((len(RECOGNISER_GRID), len(SWITCH_PENALTIES)))
     for fit_idx, held in GroupKFold(3).split(train, groups=people[train]):
         fit_idx, held = train[fit_idx], train[held]
-        model = clone(segmenter).fit([takes[i] for i in fit_idx], gestures[fit_idx])
         long_takes, truth = concatenated_takes(takes, gestures, people, held)
-        probas = model.predict_proba_frames(long_takes)
-        for j, penalty in enumerate(SWITCH_PENALTIES):
-            hits[j] += _path_accuracy(probas, truth, model.classes_, penalty)[0] * sum(
-                len(t) for t in truth
-            )
-    return SWITCH_PENALTIES[int(np.argmax(hits))]
+        n_frames = sum(len(t) for t in truth)
+        for i, params in enumerate(RECOGNISER_GRID):
+            model = clone(segmenter).set_params(**params)
+            model.fit([takes[k] for k in fit_idx], gestures[fit_idx])
+            probas = model.predict_proba_frames(long_takes)
+            for j, penalty in enumerate(SWITCH_PENALTIES):
+                accuracy = _path_accuracy(probas, truth, model.classes_, penalty)[0]
+                hits[i, j] += accuracy * n_frames
+    i, j = np.unravel_index(int(np.argmax(hits)), hits.shape)
+    return RECOGNISER_GRID[i], SWITCH_PENALTIES[j]
 
 
 def labelling(quick, window=60):
@@ -354,8 +360,9 @@ def labelling(quick, window=60):
 
     Four takes of one held-out person end to end (mostly different gestures);
     every frame's truth is the gesture of its take. The recogniser is the
-    recommended MotionClassifier on windows of ``window`` frames (4 s); the switch
-    penalty is chosen by GroupKFold(3) over the training people; the frames'
+    recommended MotionClassifier on windows of ``window`` frames (4 s); its column
+    scaling and C (RECOGNISER_GRID: its defaults, or standardised columns) and the
+    switch penalty are chosen by GroupKFold(3) over the training people; the frames'
     labels without the path (penalty 0) are given beside it, from the same probabilities.
     """
     takes, _, gestures, people = msrc12()
@@ -368,10 +375,11 @@ def labelling(quick, window=60):
     recogniser = MotionClassifier(layout="kinect_v1", frame_rate=RATE)
     segmenter = ActivitySegmenter(recogniser, window=window, step=5, train_step=15)
     start = time.perf_counter()
-    penalty = _choose_penalty(segmenter, takes, gestures, people, train)
+    params, penalty = _choose_penalty(segmenter, takes, gestures, people, train)
     cv_s = time.perf_counter() - start
     start = time.perf_counter()
-    segmenter.set_params(switch_penalty=penalty).fit([takes[i] for i in train], gestures[train])
+    segmenter.set_params(switch_penalty=penalty, **params)
+    segmenter.fit([takes[i] for i in train], gestures[train])
     fit_s = time.perf_counter() - start
     start = time.perf_counter()
     probas = segmenter.predict_proba_frames(long_takes)
@@ -384,12 +392,17 @@ def labelling(quick, window=60):
     rows = []
     for name, labels, acc, chosen in (
         (
-            "MotionClassifier windows, best path (switch penalty by CV)",
+            f"MotionClassifier windows {params or '(defaults)'}, best path (by CV)",
             predicted,
             accuracy,
             penalty,
         ),
-        ("MotionClassifier windows, most probable class per frame", plain_labels, plain, 0.0),
+        (
+            f"MotionClassifier windows {params or '(defaults)'}, most probable class per frame",
+            plain_labels,
+            plain,
+            0.0,
+        ),
     ):
         rows.append(
             {
