@@ -311,7 +311,8 @@ def build_tree_out_of_core(
 
     Examples
     --------
-    >>> import numpy as np, tempfile, os
+    >>> import numpy as np, pytest, tempfile, os
+    >>> _ = pytest.importorskip("dask")  # pip install "skmotion[distributed]"
     >>> from skmotion.tree import MotionTree, build_tree_out_of_core
     >>> rng = np.random.default_rng(0)
     >>> frames = np.r_[rng.normal(0, 1, (3000, 3)), rng.normal(8, 1, (1000, 3))]
