@@ -86,7 +86,8 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
        Full standardisation would give a leaf that a few training frames
        reach the weight of the commonest pose; no scaling would leave the
        occupancies (shares of frames) far quieter than the channel means. The
-       square root, between the two, measured best on every development set.
+       square root, between the two, measured best over the development sets
+       taken together (user guide: the defaults study).
 
     Parameters
     ----------
