@@ -5,6 +5,7 @@ from numbers import Integral, Real
 import numpy as np
 from sklearn.base import BaseEstimator, ClassifierMixin
 from sklearn.linear_model import LogisticRegression
+from sklearn.preprocessing import StandardScaler
 from sklearn.utils.multiclass import check_classification_targets
 from sklearn.utils.validation import check_is_fitted
 
@@ -272,11 +273,10 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             sparse_output=False,
         ).fit(scaled)
         features = self.encoder_.transform(scaled)
-        self.column_center_ = features.mean(axis=0)
-        spread = features.std(axis=0)
-        # a spread at rounding level is a constant column (as in StandardScaler)
-        constant = spread <= 10 * np.finfo(float).eps * np.maximum(np.abs(self.column_center_), 1)
-        self.column_scale_ = np.where(constant, 1.0, spread) ** self.column_power
+        # StandardScaler's mean and spread (a constant column gets spread 1), to a power
+        columns = StandardScaler().fit(features)
+        self.column_center_ = columns.mean_
+        self.column_scale_ = columns.scale_**self.column_power
         say(self.verbose, f"MotionClassifier: the classifier on {features.shape[1]} columns")
         self.classifier_ = LogisticRegression(C=self.C, max_iter=1000).fit(
             self._columns(features), y
