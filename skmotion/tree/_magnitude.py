@@ -66,8 +66,7 @@ def check_magnitude(clips, estimator, *, center=0.0, scale=1.0, limit=None, why=
         center_i = np.broadcast_to(center, clip.shape[1:])
         scale_i = np.broadcast_to(scale, clip.shape[1:])
         with np.errstate(over="ignore", invalid="ignore"):
-            high = np.abs(clip.max(axis=0) - center_i)
-            worst = np.maximum(high, np.abs(clip.min(axis=0) - center_i)) / scale_i
+            worst = _reach(clip.max(axis=0), clip.min(axis=0), center_i, scale_i)
         bad = np.flatnonzero(~(worst <= limit))
         if bad.size:
             _refuse(clip, i, int(bad[0]), center_i, scale_i, estimator, limit, why)
@@ -106,7 +105,7 @@ def check_stacked_magnitude(frames, offsets, estimator, checks):
     """  # noqa: E501
     if not frames.size:
         return
-    limit = float(np.sqrt(np.finfo(np.float64).max / (4.0 * frames.size)))
+    limit = overflow_limit([frames])
     # all frames' extremes first (fast contiguous reductions): when they pass, every clip's
     # do (|x - c| / s grows with |x - c|, also in rounding); only else each clip's
     high, low = np.maximum.reduce(frames, axis=0), np.minimum.reduce(frames, axis=0)
