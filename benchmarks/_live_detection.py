@@ -335,7 +335,7 @@ def _path_accuracy(probas, truth, classes, penalty):
     return float(np.mean(np.concatenate(labels) == np.concatenate(truth))), labels
 
 
-def _choose_penalty(segmenter, takes, gestures, people, train):
+def _choose_recogniser_and_penalty(segmenter, takes, gestures, people, train):
     """The recogniser's setting (of RECOGNISER_GRID) and the switch penalty of the best frame
     accuracy on out-of-fold concatenated takes of the training people (GroupKFold(3) over
     them): the test people never enter the choice."""
@@ -375,7 +375,7 @@ def labelling(quick, window=60):
     recogniser = MotionClassifier(layout="kinect_v1", frame_rate=RATE)
     segmenter = ActivitySegmenter(recogniser, window=window, step=5, train_step=15)
     start = time.perf_counter()
-    params, penalty = _choose_penalty(segmenter, takes, gestures, people, train)
+    params, penalty = _choose_recogniser_and_penalty(segmenter, takes, gestures, people, train)
     cv_s = time.perf_counter() - start
     start = time.perf_counter()
     segmenter.set_params(switch_penalty=penalty, **params)
