@@ -88,6 +88,13 @@ permute = Extension(
     ["skmotion/tree/_build/_permute.pyx"],
     extra_compile_args=["-O3"],
 )
+# A tree node's moments (centred in cached chunks, one dsyrk each) and the partition of its
+# rows at a cut, in place and without the GIL (tree/_build/_node_passes, the build's passes).
+node_passes = Extension(
+    "skmotion.tree._build._node_passes",
+    ["skmotion/tree/_build/_node_passes.pyx"],
+    extra_compile_args=["-O3"],
+)
 # Frames walked down the upper layers of a motion tree from their projections, one compiled
 # loop instead of array operations per layer (tree/_encoding/_routing, the encoder's router).
 walk = Extension(
@@ -119,6 +126,7 @@ setup(
             occurrence_loops,
             group_sums,
             permute,
+            node_passes,
             walk,
             live_window,
             live_path,

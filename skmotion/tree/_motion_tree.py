@@ -8,6 +8,7 @@ its per-layer views and the routing of frames through the splits.
 from numbers import Integral
 
 import numpy as np
+from joblib import effective_n_jobs
 
 from skmotion.base import VersionedStateMixin
 from skmotion.tree._build import PAPER_TREE, TreeParams, build_nodes
@@ -126,6 +127,7 @@ class MotionTree(VersionedStateMixin):
         covariance_type=PAPER_TREE.covariance_type,
         reg_covar=PAPER_TREE.reg_covar,
         copy=True,
+        n_jobs=None,
     ):
         """Build the tree over frames.
 
@@ -163,6 +165,11 @@ class MotionTree(VersionedStateMixin):
             order at the end, so it holds no second copy of the frames (the same
             tree; about 1.1 times the frames' memory at most instead of 2.1).
             Do not read ``frames`` from another thread during the build.
+        n_jobs : int, default=None
+            Threads that process the nodes of a layer at once (the passes over
+            the frames release the GIL). None means 1 unless in a
+            :func:`joblib.parallel_backend` context; -1 means all processors.
+            The tree is the same for any value.
 
         Returns
         -------
@@ -176,16 +183,16 @@ class MotionTree(VersionedStateMixin):
             covariance_type=covariance_type,
             reg_covar=reg_covar,
         )
-        return cls.from_params(frames, params, copy=copy)
+        return cls.from_params(frames, params, copy=copy, n_jobs=n_jobs)
 
     @classmethod
-    def from_params(cls, frames, params, *, copy=True):
+    def from_params(cls, frames, params, *, copy=True, n_jobs=None):
         """Build the tree over frames with the parameters of a ``TreeParams``.
 
         ``copy=False`` (for a caller's own C-contiguous float64 array, such as a
         fit's stacked frames): the build works in ``frames`` itself, reordering
         them and putting them back in their order at the end, so it holds no
-        second copy of the frames (the same tree).
+        second copy of the frames (the same tree). ``n_jobs``: as for :meth:`build`.
         """
         X = np.asarray(frames, dtype=np.float64)
         if X.ndim != 2 or len(X) == 0 or X.shape[1] == 0:
@@ -204,7 +211,8 @@ class MotionTree(VersionedStateMixin):
         # a conversion made a new array: the build may work in it, there is no other copy
         owned = not isinstance(frames, np.ndarray) or not np.may_share_memory(X, frames)
         in_place = (owned or not copy) and X.flags.writeable
-        nodes = build_nodes(X, **params.as_dict(), copy=not in_place)
+        threads = effective_n_jobs(n_jobs)
+        nodes = build_nodes(X, **params.as_dict(), copy=not in_place, n_jobs=threads)
         return cls(**nodes, covariance_type=params.covariance_type)
 
     # -- sizes and layer structure ------------------------------------------------

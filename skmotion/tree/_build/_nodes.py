@@ -9,11 +9,14 @@ O(N log N) for N frames when the tree is about ``log N`` deep. There are no
 pairwise distances and no Python loop over frames (only over nodes).
 """
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 from scipy.linalg import eigh
 from scipy.linalg.lapack import dsyevr
 
 from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
+from skmotion.tree._build._node_passes import partition_rows, shifted_moments
 from skmotion.tree._build._permute import permute_rows
 from skmotion.tree._build._split import best_split
 
@@ -22,6 +25,9 @@ __all__ = ["build_nodes"]
 # A cut must sit in a gap wider than this many units of the projections'
 # rounding error, so routing a training frame again always finds the same side.
 _GAP_RESOLUTION = 1e-12
+# The fewest frames a thread is handed at once when the nodes of a layer are processed
+# in threads.
+_TASK_FRAMES = 1 << 16
 
 
 def _top_eigenvectors(symmetric, k):
@@ -66,10 +72,13 @@ def _principal_axis(centred, scatter):
 
 class _Builder:
     """Breadth-first construction on the frames reordered so that every node's frames
-    are one contiguous block (splitting a node reorders its block in place).
+    are one contiguous block (splitting a node partitions its block in place).
 
     The frames are a copy, or with ``copy=False`` the caller's own array, whose
-    order is put back after the build (``index`` follows every row)."""
+    order is put back after the build (``index`` follows every row). With
+    ``n_jobs`` above 1 the nodes of a layer are processed in that many threads (the
+    passes over the frames release the GIL); every node is computed as it would be
+    alone, so the tree does not depend on ``n_jobs``."""
 
     def __init__(
         self,
@@ -81,6 +90,7 @@ class _Builder:
         covariance_type,
         reg_covar,
         copy=True,
+        n_jobs=1,
     ):
         # Rounding of a projection x @ axis is below d * eps * max|x|; cuts must
         # sit in gaps far wider, so a training frame always routes back to its side.
@@ -95,6 +105,7 @@ class _Builder:
         self.min_leaf = min_samples_leaf
         self.split = split
         self.kind = covariance_type
+        self.n_jobs = n_jobs
         self.nodes = {
             k: []
             for k in (
@@ -127,65 +138,121 @@ class _Builder:
             self.nodes[key].append(value)
         return len(self.nodes["parent"]) - 1
 
+    def moments(self, node, block, scatter):
+        """The node's mean, scatter and squared centred norms (None unless ``"full"``).
+
+        Without ``scatter`` (a node that will not be split, under a diagonal or
+        spherical covariance, which need only the scatter's diagonal) the scatter
+        is diagonal: the off-diagonal products are not computed. The sums are taken
+        about the parent's mean (the root's own, computed first), close to the node's.
+        """
+        if self.kind == "full":  # Ledoit-Wolf needs every frame's centred norm
+            return centred_moments(block)
+        n = len(block)
+        parent = self.nodes["parent"][node]
+        shift = block.mean(axis=0) if parent < 0 else self.nodes["mean"][parent]
+        sums, products = shifted_moments(block, shift, scatter)
+        mean = shift + sums / n
+        if scatter:
+            products -= np.outer(sums, sums / n)
+        else:  # a constant channel may round a hair below zero
+            products = np.diag(np.maximum(products - sums * (sums / n), 0.0))
+        return mean, products, None
+
     def process(self, node, may_split):
-        """Compute the node's Gaussian; split it when allowed and possible."""
+        """The node's Gaussian and, when allowed and possible, its split (the block
+        partitioned in place); returns what :meth:`record` enters in the tree."""
         nodes = self.nodes
         start, stop = nodes["start"][node], nodes["stop"][node]
         block = self.blocks[start:stop]
         n, d = block.shape
-        mean, scatter, sq_norms = centred_moments(block)
+        may_split = may_split and n >= self.min_split
+        root = nodes["parent"][node] < 0
+        mean, scatter, sq_norms = self.moments(node, block, may_split or root)
+        if sq_norms is None:  # the covariance estimators take the frame count from it
+            sq_norms = np.zeros(n)
         if self.reg is None:  # the root: reg_covar is relative to its mean per-channel variance
             scale = np.trace(scatter) / (n * d)
             self.reg = self.reg_covar * scale if scale > 0 else float(self.reg_covar)
+        if root:
             self.root_scatter = scatter
-        nodes["mean"][node] = mean
-        nodes["cov"][node] = estimate_covariance(scatter, sq_norms, self.kind, self.reg)
-        if (
-            self.kind == "full" and n <= d
-        ):  # fewer frames than channels: the covariance is low rank plus a floor
-            nodes["low_rank"][node] = low_rank_covariance(block - mean, scatter, sq_norms, self.reg)
-        if not (may_split and n >= self.min_split):
-            return ()
+        result = {"mean": mean, "cov": estimate_covariance(scatter, sq_norms, self.kind, self.reg)}
+        if self.kind == "full" and n <= d:  # the covariance is low rank plus a floor
+            result["low_rank"] = low_rank_covariance(block - mean, scatter, sq_norms, self.reg)
+        if not may_split:
+            return result
         axis = _principal_axis(block - mean if n < d else None, scatter)
         if axis is None:
-            return ()
+            return result
         proj = block @ axis  # as routing computes it
-        order = np.argsort(proj, kind="stable")
-        ordered = proj[order]
-        del proj
+        ordered = np.sort(proj)
         n_left = best_split(ordered, self.split, min_samples_leaf=self.min_leaf, tol=self.tol)
         if n_left is None:
+            return result
+        # the cut sits in a gap far wider than rounding, so it separates the sides exactly
+        thr = 0.5 * (ordered[n_left - 1] + ordered[n_left])
+        del ordered
+        index = None if self.index is None else self.index[start:stop]
+        if partition_rows(block, proj, thr, index) != n_left:  # pragma: no cover - a bug
+            raise RuntimeError(f"node {node}: the cut does not separate {n_left} frames.")
+        result.update(axis=axis, thr=thr, n_left=n_left)
+        return result
+
+    def record(self, node, result):
+        """Enter a node's Gaussian and split; add its children (None for a leaf)."""
+        nodes = self.nodes
+        for key in ("mean", "cov", "low_rank", "axis", "thr"):
+            if key in result:
+                nodes[key][node] = result[key]
+        if "n_left" not in result:
             return ()
-        # in place, along the permutation's cycles: block[order] would copy the whole block
-        permute_rows(block, order)
-        if self.index is not None:
-            self.index[start:stop] = self.index[start:stop][order]
+        start, stop, cut = nodes["start"][node], nodes["stop"][node], result["n_left"]
         depth = nodes["depth"][node] + 1
-        left = self.add(node, depth, start, start + n_left)
-        right = self.add(node, depth, start + n_left, stop)
+        left = self.add(node, depth, start, start + cut)
+        right = self.add(node, depth, start + cut, stop)
         nodes["left"][node], nodes["right"][node] = left, right
-        nodes["axis"][node] = axis
-        nodes["thr"][node] = 0.5 * (ordered[n_left - 1] + ordered[n_left])
         return (left, right)
+
+    def process_layer(self, nodes, may_split, pool):
+        """``process`` of each node, in threads when there is a pool: consecutive nodes
+        are grouped into tasks of at least ``_TASK_FRAMES`` frames (a thread hand-off
+        costs more than a small node's work)."""
+        if pool is None or len(nodes) < 2:
+            return [self.process(node, may_split) for node in nodes]
+        tasks, task, frames = [], [], 0
+        for node in nodes:
+            task.append(node)
+            frames += self.nodes["stop"][node] - self.nodes["start"][node]
+            if frames >= _TASK_FRAMES:
+                tasks.append(task)
+                task, frames = [], 0
+        if task:
+            tasks.append(task)
+        done = pool.map(lambda group: [self.process(node, may_split) for node in group], tasks)
+        return [result for group in done for result in group]
 
     def run(self):
         root = self.add(-1, 0, 0, len(self.blocks))
         layers = [np.array([root])]
         depth = 0
-        while True:
-            may_split = self.max_depth is None or depth < self.max_depth
-            next_layer, grew = [], False
-            for node in layers[-1]:
-                if self.nodes["depth"][node] == depth:
-                    children = self.process(node, may_split)
-                else:  # a leaf of an upper layer, copied down
-                    children = ()
-                grew |= bool(children)
-                next_layer.extend(children or (node,))
-            if not grew:
-                break
-            layers.append(np.array(next_layer))
-            depth += 1
+        pool = ThreadPoolExecutor(self.n_jobs) if self.n_jobs > 1 else None
+        try:
+            while True:
+                may_split = self.max_depth is None or depth < self.max_depth
+                current = [node for node in layers[-1] if self.nodes["depth"][node] == depth]
+                results = dict(zip(current, self.process_layer(current, may_split, pool)))
+                next_layer, grew = [], False
+                for node in layers[-1]:  # a leaf of an upper layer is copied down
+                    children = self.record(node, results[node]) if node in results else ()
+                    grew |= bool(children)
+                    next_layer.extend(children or (node,))
+                if not grew:
+                    break
+                layers.append(np.array(next_layer))
+                depth += 1
+        finally:
+            if pool is not None:
+                pool.shutdown()
         if self.index is not None:  # the caller's frames back in their order
             inverse = np.empty_like(self.index)
             inverse[self.index] = np.arange(len(self.index))
@@ -204,6 +271,7 @@ def build_nodes(
     covariance_type,
     reg_covar,
     copy=True,
+    n_jobs=1,
 ):
     """Grow the tree over validated frames; the per-node arrays and the layers.
 
@@ -214,6 +282,8 @@ def build_nodes(
     copy : bool, default=True
         False: work in ``X`` itself (no copy of the frames), which is reordered
         during the build and put back in its order at the end (the same values).
+    n_jobs : int, default=1
+        Threads processing the nodes of a layer (the same tree for any number).
     max_depth, min_samples_split, min_samples_leaf, split, covariance_type
         As for :meth:`MotionTree.build`.
     reg_covar : float
@@ -231,7 +301,15 @@ def build_nodes(
         absolute regularisation): the arguments of ``MotionTree``.
     """
     builder = _Builder(
-        X, max_depth, min_samples_split, min_samples_leaf, split, covariance_type, reg_covar, copy
+        X,
+        max_depth,
+        min_samples_split,
+        min_samples_leaf,
+        split,
+        covariance_type,
+        reg_covar,
+        copy,
+        n_jobs,
     )
     layers = builder.run()
     nodes = builder.nodes
