@@ -15,10 +15,10 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.linalg.lapack import dsyevr
 
-from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
 from skmotion.tree._build._node_passes import partition_rows, shifted_moments
 from skmotion.tree._build._permute import permute_rows
 from skmotion.tree._build._split import best_split
+from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
 
 __all__ = ["build_nodes"]
 
@@ -28,6 +28,14 @@ _GAP_RESOLUTION = 1e-12
 # The fewest frames a thread is handed at once when the nodes of a layer are processed
 # in threads.
 _TASK_FRAMES = 1 << 16
+# A child's scatter may be the parent's minus its sibling's (no pass over its rows) when
+# the parent has at least this many rows per channel (the parent's d x d scatter is kept
+# until its children are built: at most a 64th of the rows' memory). The bound on the
+# rounding of a scatter summed directly, relative to its trace, and the largest relative
+# error bound a derived scatter may have (else it is summed from its rows).
+_KEEP_ROWS_PER_CHANNEL = 64
+_SUM_ROUNDING = 1e-13
+_DERIVED_ACCURACY = 1e-9
 
 
 def _top_eigenvectors(symmetric, k):
@@ -106,6 +114,7 @@ class _Builder:
         self.split = split
         self.kind = covariance_type
         self.n_jobs = n_jobs
+        self.kept = {}  # per split node of the last layer: its scatter and an error bound
         self.nodes = {
             k: []
             for k in (
@@ -138,28 +147,54 @@ class _Builder:
             self.nodes[key].append(value)
         return len(self.nodes["parent"]) - 1
 
-    def moments(self, node, block, scatter):
-        """The node's mean, scatter and squared centred norms (None unless ``"full"``).
+    def moments(self, node, block, scatter, sibling=None):
+        """The node's mean, scatter and squared centred norms (None unless ``"full"``),
+        and the products about the parent's mean it was computed from (or None).
 
         Without ``scatter`` (a node that will not be split, under a diagonal or
         spherical covariance, which need only the scatter's diagonal) the scatter
         is diagonal: the off-diagonal products are not computed. The sums are taken
         about the parent's mean (the root's own, computed first), close to the node's.
+        With the ``sibling``'s products, the scatter is the parent's minus the
+        sibling's (no pass over the rows), unless too much would be lost to
+        cancellation (see :meth:`derived`).
         """
         if self.kind == "full":  # Ledoit-Wolf needs every frame's centred norm
-            return centred_moments(block)
+            return (*centred_moments(block), None)
         n = len(block)
         parent = self.nodes["parent"][node]
         shift = block.mean(axis=0) if parent < 0 else self.nodes["mean"][parent]
-        sums, products = shifted_moments(block, shift, scatter)
+        raw = self.derived(parent, sibling) if scatter else None
+        if raw is None:
+            raw = (*shifted_moments(block, shift, scatter), 0.0)
+        sums, products, error = raw
         mean = shift + sums / n
-        if scatter:
-            products -= np.outer(sums, sums / n)
-        else:  # a constant channel may round a hair below zero
-            products = np.diag(np.maximum(products - sums * (sums / n), 0.0))
-        return mean, products, None
+        if not scatter:  # a constant channel may round a hair below zero
+            return mean, np.diag(np.maximum(products - sums * (sums / n), 0.0)), None, None
+        scatter = products - np.outer(sums, sums / n)
+        # the error bound of the products: a direct sum's rounding, or what the derivation's was
+        raw = (sums, products, error or _SUM_ROUNDING * np.trace(products))
+        return mean, scatter, None, raw if parent >= 0 else None
 
-    def process(self, node, may_split):
+    def derived(self, parent, sibling):
+        """The products about the parent's mean, ``(sums, products, error)``, as the
+        parent's scatter minus the sibling's products; None when the parent's scatter
+        was not kept, or when its error bound exceeds ``_DERIVED_ACCURACY`` of the result
+        (a node with far less spread than its parent: the difference would cancel)."""
+        kept = self.kept.get(parent)
+        if kept is None or sibling is None or sibling.get("raw") is None:
+            return None
+        parent_scatter, parent_error = kept
+        sums, products, error = sibling["raw"]
+        mine = parent_scatter - products
+        error = (
+            parent_error + error + _SUM_ROUNDING * (np.trace(parent_scatter) + np.trace(products))
+        )
+        if not error <= _DERIVED_ACCURACY * np.trace(mine):
+            return None
+        return -sums, mine, error
+
+    def process(self, node, may_split, sibling=None):
         """The node's Gaussian and, when allowed and possible, its split (the block
         partitioned in place); returns what :meth:`record` enters in the tree."""
         nodes = self.nodes
@@ -168,7 +203,7 @@ class _Builder:
         n, d = block.shape
         may_split = may_split and n >= self.min_split
         root = nodes["parent"][node] < 0
-        mean, scatter, sq_norms = self.moments(node, block, may_split or root)
+        mean, scatter, sq_norms, raw = self.moments(node, block, may_split or root, sibling)
         if sq_norms is None:  # the covariance estimators take the frame count from it
             sq_norms = np.zeros(n)
         if self.reg is None:  # the root: reg_covar is relative to its mean per-channel variance
@@ -177,6 +212,7 @@ class _Builder:
         if root:
             self.root_scatter = scatter
         result = {"mean": mean, "cov": estimate_covariance(scatter, sq_norms, self.kind, self.reg)}
+        result["raw"] = raw
         if self.kind == "full" and n <= d:  # the covariance is low rank plus a floor
             result["low_rank"] = low_rank_covariance(block - mean, scatter, sq_norms, self.reg)
         if not may_split:
@@ -196,7 +232,22 @@ class _Builder:
         if partition_rows(block, proj, thr, index) != n_left:  # pragma: no cover - a bug
             raise RuntimeError(f"node {node}: the cut does not separate {n_left} frames.")
         result.update(axis=axis, thr=thr, n_left=n_left)
+        if n >= _KEEP_ROWS_PER_CHANNEL * d and self.kind != "full":  # for a child's derivation
+            error = 0.0 if raw is None else raw[2]
+            result["keep"] = (scatter, error + _SUM_ROUNDING * np.trace(scatter))
         return result
+
+    def process_family(self, family, may_split):
+        """``process`` of a node or of two siblings: the one with fewer rows first, whose
+        products give the other's scatter."""
+        if len(family) == 1:
+            return [self.process(family[0], may_split)]
+        sizes = [self.nodes["stop"][k] - self.nodes["start"][k] for k in family]
+        first = int(sizes[1] < sizes[0])
+        results = [None, None]
+        results[first] = self.process(family[first], may_split)
+        results[1 - first] = self.process(family[1 - first], may_split, results[first])
+        return results
 
     def record(self, node, result):
         """Enter a node's Gaussian and split; add its children (None for a leaf)."""
@@ -204,6 +255,8 @@ class _Builder:
         for key in ("mean", "cov", "low_rank", "axis", "thr"):
             if key in result:
                 nodes[key][node] = result[key]
+        if "keep" in result:
+            self.next_kept[node] = result["keep"]
         if "n_left" not in result:
             return ()
         start, stop, cut = nodes["start"][node], nodes["stop"][node], result["n_left"]
@@ -214,21 +267,30 @@ class _Builder:
         return (left, right)
 
     def process_layer(self, nodes, may_split, pool):
-        """``process`` of each node, in threads when there is a pool: consecutive nodes
-        are grouped into tasks of at least ``_TASK_FRAMES`` frames (a thread hand-off
-        costs more than a small node's work)."""
-        if pool is None or len(nodes) < 2:
-            return [self.process(node, may_split) for node in nodes]
+        """``process_family`` of each node or pair of siblings, in threads when there is
+        a pool: consecutive families are grouped into tasks of at least ``_TASK_FRAMES``
+        frames (a thread hand-off costs more than a small node's work)."""
+        parents = self.nodes["parent"]
+        families = []
+        for node in nodes:  # siblings are consecutive: both children of a split are in the layer
+            if families and parents[node] >= 0 and parents[families[-1][0]] == parents[node]:
+                families[-1].append(node)
+            else:
+                families.append([node])
         tasks, task, frames = [], [], 0
-        for node in nodes:
-            task.append(node)
-            frames += self.nodes["stop"][node] - self.nodes["start"][node]
-            if frames >= _TASK_FRAMES:
+        for family in families:
+            task.append(family)
+            frames += sum(self.nodes["stop"][k] - self.nodes["start"][k] for k in family)
+            if frames >= _TASK_FRAMES or pool is None:
                 tasks.append(task)
                 task, frames = [], 0
         if task:
             tasks.append(task)
-        done = pool.map(lambda group: [self.process(node, may_split) for node in group], tasks)
+
+        def work(task):
+            return [result for family in task for result in self.process_family(family, may_split)]
+
+        done = map(work, tasks) if pool is None or len(tasks) < 2 else pool.map(work, tasks)
         return [result for group in done for result in group]
 
     def run(self):
@@ -241,11 +303,13 @@ class _Builder:
                 may_split = self.max_depth is None or depth < self.max_depth
                 current = [node for node in layers[-1] if self.nodes["depth"][node] == depth]
                 results = dict(zip(current, self.process_layer(current, may_split, pool)))
+                self.next_kept = {}  # the scatters this layer's splits keep for their children
                 next_layer, grew = [], False
                 for node in layers[-1]:  # a leaf of an upper layer is copied down
                     children = self.record(node, results[node]) if node in results else ()
                     grew |= bool(children)
                     next_layer.extend(children or (node,))
+                self.kept = self.next_kept
                 if not grew:
                     break
                 layers.append(np.array(next_layer))
