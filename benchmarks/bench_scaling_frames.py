@@ -7,6 +7,8 @@ reports the seconds and its peak resident memory (``VmHWM``, the frames included
 - ``MotionTree.build(copy=False)``: the tree the fits build, ``max_depth=8`` with
   median cuts (256 leaves: the vocabulary size of the peers), ``min_samples_leaf=16``,
   working in the frame array itself;
+- ``MotionTree.build(copy=False, n_jobs=2)``: the same with the nodes of a layer in two
+  threads (the same tree);
 - ``MotionTree.build``: the same with the default ``copy=True`` (a copy of the frames);
 - ``MotionTreeEncoder().fit``: the encoder with its defaults, from clips of 100 frames
   (views into the frame array);
@@ -21,7 +23,8 @@ build of the skmotion source tree SRC (for example an older checkout) on the sam
 frames. The two copying builds stop at 10^6 frames (their memory figure is clear
 there). The growth exponent of each method is the slope of log seconds against log
 frames over the sizes it ran. ``--methods`` runs some of them (``tree_in_place``,
-``tree``, ``encoder``, ``bisecting``, ``minibatch``). Results:
+``tree_threads``, ``tree``, ``encoder``, ``bisecting``, ``minibatch``). Each result row
+carries the load average when its fit ended. Results:
 ``results/<--name, default scaling_frames>.{csv,md}``.
 Run: ``python benchmarks/bench_scaling_frames.py``.
 """
@@ -43,6 +46,7 @@ N_CHANNELS = 60
 BLOCK = 1 << 16
 METHODS = {
     "MotionTree.build(copy=False)": "tree_in_place",
+    "MotionTree.build(copy=False, n_jobs=2)": "tree_threads",
     "MotionTree.build (copy)": "tree",
     "MotionTreeEncoder().fit": "encoder",
     "BisectingKMeans(256)": "bisecting",
@@ -84,6 +88,7 @@ def worker(method, n):
     build = dict(max_depth=8, split="median", min_samples_leaf=16)
     fits = {
         "tree_in_place": lambda: MotionTree.build(frames, copy=False, **build).n_nodes[-1],
+        "tree_threads": lambda: MotionTree.build(frames, copy=False, n_jobs=2, **build).n_nodes[-1],
         "tree": lambda: MotionTree.build(frames, **build).n_nodes[-1],
         "before": lambda: MotionTree.build(frames, **build).n_nodes[-1],
         "encoder": lambda: (
@@ -158,6 +163,7 @@ def main(sizes, peers_up_to, before=None, only=None, name="scaling_frames"):
                     "growth over the array MB": (result["peak"] - result["before"]) / 2**20,
                     "clusters": result["leaves"],
                     "growth exponent": "",
+                    "load": os.getloadavg()[0],
                 }
             )
             print(rows[-1], f"load {os.getloadavg()[0]:.1f}", flush=True)

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
@@ -88,3 +88,33 @@ def test_equal_values_are_never_separated():
 def test_unknown_criterion():
     with pytest.raises(ValueError, match="criterion must be one of"):
         split_scores(np.arange(3.0), "gini")
+
+
+def _median_by_scores(values, leaf, tol):
+    """The median rule as its definition states it: the admissible cut of least score."""
+    n = len(values)
+    if n < 2 * leaf:
+        return None
+    admissible = np.diff(values) > tol
+    admissible[: leaf - 1] = False
+    admissible[n - leaf :] = False
+    if not admissible.any():
+        return None
+    return int(np.argmin(np.where(admissible, split_scores(values, "median"), np.inf))) + 1
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.integers(1, 3_000),
+    st.integers(1, 40),
+    st.sampled_from([0.0, 1e-12, 0.5]),
+    st.integers(1, 50),
+    st.integers(0, 2**32 - 1),
+)
+def test_median_cut_is_the_least_score(n, leaf, tol, distinct, seed):
+    # few distinct values: long runs of ties around the middle push the cut outwards
+    rng = np.random.default_rng(seed)
+    values = np.sort(rng.integers(0, distinct, n).astype(float))
+    assert best_split(values, "median", min_samples_leaf=leaf, tol=tol) == _median_by_scores(
+        values, leaf, tol
+    )

@@ -4,9 +4,11 @@ A node's frames are centred and projected on their first principal axis, and
 the sorted projections are cut in two by a 1-D criterion (minimum-error
 thresholding by default); nodes split until they are too small or the tree is
 deep enough. A node that stops early is copied down, so every layer holds all
-frames. Building costs one sort and one ``n x d`` scatter per split node:
+frames. Building costs one sort of the projections and one ``n x d`` scatter per
+split node (for the smaller of two siblings; the other's is the parent's minus it):
 O(N log N) for N frames when the tree is about ``log N`` deep. There are no
-pairwise distances and no Python loop over frames (only over nodes).
+pairwise distances and no Python loop over frames (only over nodes); the passes
+over a node's rows are compiled (``_node_passes.pyx``).
 """
 
 from concurrent.futures import ThreadPoolExecutor

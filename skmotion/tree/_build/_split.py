@@ -92,6 +92,28 @@ def split_scores(sorted_values, criterion, *, var_floor=0.0):
     return rule(np.asarray(sorted_values, dtype=np.float64), var_floor)
 
 
+def _nearest_middle_cut(sorted_values, leaf, tol):
+    """The median rule's cut without its arrays of ``n`` scores: the admissible cut
+    nearest the middle (the lower of two equally near), found in windows about the
+    middle that double until one holds an admissible cut. Every cut outside a window
+    is farther from the middle than every cut in it, so the first window's best is
+    the best; its arrays are the window's size, not the node's."""
+    n = len(sorted_values)
+    half = n / 2.0
+    width = 64
+    while True:
+        low = max(leaf, int(np.ceil(half - width)))  # the cuts i with |i - n/2| <= width
+        high = min(n - leaf, int(np.floor(half + width)))
+        cuts = np.arange(low, high + 1)
+        gaps = sorted_values[low : high + 1] - sorted_values[low - 1 : high]
+        found = cuts[gaps > tol]
+        if len(found):
+            return int(found[np.argmin(np.abs(found - half))])
+        if low == leaf and high == n - leaf:
+            return None
+        width *= 2
+
+
 def best_split(sorted_values, criterion, *, min_samples_leaf=1, tol=0.0):
     """The best admissible cut of sorted projections, or None.
 
@@ -132,6 +154,8 @@ def best_split(sorted_values, criterion, *, min_samples_leaf=1, tol=0.0):
     leaf = max(int(min_samples_leaf), 1)
     if n < 2 * leaf:
         return None
+    if criterion == "median":
+        return _nearest_middle_cut(sorted_values, leaf, tol)
     admissible = np.diff(sorted_values) > tol
     admissible[: leaf - 1] = False
     admissible[n - leaf :] = False
