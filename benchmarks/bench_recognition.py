@@ -69,6 +69,8 @@ STUDY = {  # candidate -> MotionClassifier parameters (the defaults are the firs
     "velocity weight 0.5": {"velocity_weight": 0.5},
     "velocity weight 2": {"velocity_weight": 2.0},
     "per-channel standardisation": {"scaling": "channels"},
+    "split two_means": {"split": "two_means"},
+    "class_weight balanced": {"class_weight": "balanced"},
 }
 CV_GRID = [{"C": c, "column_power": p} for c in (0.3, 1.0, 3.0) for p in (0.5, 1.0)]
 

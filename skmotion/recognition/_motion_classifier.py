@@ -15,6 +15,7 @@ from skmotion.kinematics import Skeleton
 from skmotion.kinematics._layouts import Layout
 from skmotion.preprocessing import VirtualMarkerTransform
 from skmotion.tree import MotionTreeEncoder
+from skmotion.tree._build import TREE_CONSTRAINTS
 from skmotion.tree._calibration import mixture_novelty
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._progress import say
@@ -116,6 +117,9 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     max_depth : int, default=6
         The motion tree's deepest layer (its vocabulary: up to ``2 ** max_depth``
         poses).
+    split : {"median", "two_means", "min_error"}, default="median"
+        How the motion tree splits a node along its principal axis (see
+        :class:`~skmotion.tree.MotionTreeEncoder`).
     residual_layers : array-like of int, default=(1, 3)
         The tree layers whose residuals are encoded.
     moment_pyramid : array-like of int, default=(1, 2, 4)
@@ -126,6 +130,10 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         their own units.
     C : float, default=1.0
         Inverse regularisation of the logistic regression.
+    class_weight : "balanced", dict or None, default=None
+        The logistic regression's class weights: ``"balanced"`` weighs each
+        class inversely to its number of training clips (for classes recorded
+        unevenly), None weighs every clip alike.
     n_jobs : int, default=None
         Clips turned into markers in parallel (joblib threads).
     verbose : int, default=0
@@ -180,10 +188,12 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         "scaling": [StrOptions({"auto", "blocks", "channels"})],
         "velocity_weight": [Interval(Real, 0, None, closed="neither")],
         "max_depth": [Interval(Integral, 1, None, closed="left")],
+        "split": TREE_CONSTRAINTS["split"],
         "residual_layers": ["array-like"],
         "moment_pyramid": ["array-like"],
         "column_power": [Interval(Real, 0, 1, closed="both")],
         "C": [Interval(Real, 0, None, closed="neither")],
+        "class_weight": [StrOptions({"balanced"}), dict, None],
         "n_jobs": [Integral, None],
         "verbose": ["verbose"],
     }
@@ -199,10 +209,12 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         scaling="auto",
         velocity_weight=1.0,
         max_depth=6,
+        split="median",
         residual_layers=(1, 3),
         moment_pyramid=(1, 2, 4),
         column_power=0.5,
         C=1.0,
+        class_weight=None,
         n_jobs=None,
         verbose=0,
     ):
@@ -213,10 +225,12 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.scaling = scaling
         self.velocity_weight = velocity_weight
         self.max_depth = max_depth
+        self.split = split
         self.residual_layers = residual_layers
         self.moment_pyramid = moment_pyramid
         self.column_power = column_power
         self.C = C
+        self.class_weight = class_weight
         self.n_jobs = n_jobs
         self.verbose = verbose
 
@@ -266,6 +280,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         say(self.verbose, f"MotionClassifier: the vocabulary over {len(frames):,} frames")
         self.encoder_ = MotionTreeEncoder(
             max_depth=self.max_depth,
+            split=self.split,
             layers="all",
             residual_layers=self.residual_layers,
             moment_pyramid=self.moment_pyramid,
@@ -278,9 +293,9 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.column_center_ = columns.mean_
         self.column_scale_ = columns.scale_**self.column_power
         say(self.verbose, f"MotionClassifier: the classifier on {features.shape[1]} columns")
-        self.classifier_ = LogisticRegression(C=self.C, max_iter=1000).fit(
-            self._columns(features), y
-        )
+        self.classifier_ = LogisticRegression(
+            C=self.C, class_weight=self.class_weight, max_iter=1000
+        ).fit(self._columns(features), y)
         self.classes_ = self.classifier_.classes_
         return self
 

@@ -80,6 +80,35 @@ def test_equals_its_steps_run_by_hand(positions):
     np.testing.assert_allclose(standard.predict_proba(Xte), head.predict_proba(Fte), atol=1e-10)
 
 
+def test_split_and_class_weight_reach_their_steps():
+    """``split`` is the tree's and ``class_weight`` the logistic regression's: the same
+    answers as the steps run by hand with them, on classes recorded unevenly."""
+    X, y = small_clips()
+    keep = np.flatnonzero((y != "wave") | (np.arange(len(y)) % 3 == 0))
+    X, y = [X[i] for i in keep], y[keep]
+    assert (y == "wave").sum() == 1 and len(y) == 7
+    params = {"max_depth": 3, "split": "two_means", "class_weight": "balanced"}
+    model = MotionClassifier(**params).fit(X, y)
+    frames = np.vstack(X)
+    scaled = [(x - frames.mean(axis=0)) / frames.std(axis=0) for x in X]
+    encoder = MotionTreeEncoder(
+        max_depth=3,
+        split="two_means",
+        layers="all",
+        moment_pyramid=(1, 2, 4),
+        standardize=False,
+        sparse_output=False,
+    ).fit(scaled)
+    F = encoder.transform(scaled)
+    spread = F.std(axis=0)
+    root = (F - F.mean(axis=0)) / np.sqrt(np.where(spread > 0, spread, 1.0))
+    head = LogisticRegression(C=1.0, class_weight="balanced", max_iter=1000).fit(root, y)
+    np.testing.assert_allclose(model.predict_proba(X), head.predict_proba(root), atol=1e-10)
+    # balanced: the one wave clip weighs 7 / (3 * 1), each other clip 7 / (3 * 3)
+    unweighted = clone(model).set_params(class_weight=None).fit(X, y)
+    assert not np.allclose(unweighted.predict_proba(X), model.predict_proba(X))
+
+
 def test_beats_nearest_neighbour_on_a_held_out_subject(positions):
     """A subject never seen in training: at least as good as 1-NN on resampled markers."""
     scores, baseline = [], []
@@ -150,6 +179,8 @@ def test_plain_channels_are_standardised_one_by_one():
         ({"C": 0.0}, "C"),
         ({"column_power": 1.5}, "column_power"),
         ({"scaling": "per-channel"}, "scaling"),
+        ({"split": "mean"}, "split"),
+        ({"class_weight": "even"}, "class_weight"),
     ],
 )
 def test_bad_parameters_are_named(params, match):
