@@ -115,6 +115,12 @@ live_path = Extension(
     ["skmotion/live/_switch_path.pyx"],
     extra_compile_args=["-O3"],
 )
+# Forward kinematics, one pass over frames and joints (kinematics/_forward.py).
+forward_loops = Extension(
+    "skmotion.kinematics._forward_loops",
+    ["skmotion/kinematics/_forward_loops.pyx"],
+    extra_compile_args=["-O3"],
+)
 setup(
     ext_modules=cythonize(
         [
@@ -130,6 +136,7 @@ setup(
             walk,
             live_window,
             live_path,
+            forward_loops,
         ]
     )
 )

@@ -1,11 +1,11 @@
-"""Batched forward kinematics: all joints, all frames, no loop over frames."""
+"""Forward kinematics: all joints, all frames, in one compiled pass."""
 
 from collections import namedtuple
 from functools import lru_cache
 
 import numpy as np
 
-from skmotion.kinematics._rotations import euler_to_matrix
+from skmotion.kinematics._forward_loops import forward_pass
 
 __all__ = ["FKResult", "forward_kinematics"]
 
@@ -24,35 +24,28 @@ rotations : ndarray of shape (n_frames, n_joints, 3, 3)
 
 @lru_cache(maxsize=64)
 def _channel_plan(skeleton):
-    """Where each channel column goes, computed once per skeleton."""
-    rot_cols, rot_joints, rot_slots = [], [], []
-    pos_cols, pos_joints, pos_axes = [], [], []
-    col = 0
-    for j, chans in enumerate(skeleton.channels):
-        order = skeleton.rotation_orders[j]
-        for c in chans:
-            axis = c[0]
-            if c.endswith("rotation"):
-                rot_cols.append(col)
-                rot_joints.append(j)
-                rot_slots.append(order.index(axis))
+    """Which channel drives each joint's rotation slots and offset, once per skeleton."""
+    n_joints = skeleton.n_joints
+    rotation_column = np.full((n_joints, 3), -1, dtype=np.intp)
+    position_column = np.full((n_joints, 3), -1, dtype=np.intp)
+    column = 0
+    for j, names in enumerate(skeleton.channels):
+        for name in names:
+            if name.endswith("rotation"):
+                rotation_column[j, skeleton.rotation_orders[j].index(name[0])] = column
             else:
-                pos_cols.append(col)
-                pos_joints.append(j)
-                pos_axes.append("XYZ".index(axis))
-            col += 1
-    rotating = sorted(set(rot_joints))
-    by_order = {}
-    for j in rotating:
-        by_order.setdefault(skeleton.rotation_orders[j], []).append(j)
-    depths = skeleton.depths
-    levels = [np.flatnonzero(depths == d) for d in range(1, int(depths.max()) + 1)]
-    as_idx = lambda v: np.asarray(v, dtype=np.intp)  # noqa: E731
+                position_column[j, "XYZ".index(name[0])] = column
+            column += 1
+    axes = np.zeros((n_joints, 3, 3)) if skeleton.axes is None else skeleton.axes
     return {
-        "rot": (as_idx(rot_cols), as_idx(rot_joints), as_idx(rot_slots)),
-        "pos": (as_idx(pos_cols), as_idx(pos_joints), as_idx(pos_axes)),
-        "by_order": {o: as_idx(js) for o, js in by_order.items()},
-        "levels": levels,
+        "rotation_column": rotation_column,
+        "axis_of_slot": np.array(
+            [["XYZ".index(a) for a in skeleton.rotation_orders[j]] for j in range(n_joints)],
+            dtype=np.intp,
+        ).reshape(n_joints, 3),
+        "position_column": position_column,
+        "offsets": np.ascontiguousarray(skeleton.offsets, dtype=float),
+        "axes": np.ascontiguousarray(axes, dtype=float),
         "parents": np.asarray(skeleton.parents, dtype=np.intp),
     }
 
@@ -72,9 +65,9 @@ def _check_channels(skeleton, channels):
 def forward_kinematics(skeleton, channels):
     """World positions and rotations of every joint for every frame.
 
-    Local rotations are built per rotation order in one vectorised call each;
-    world poses are composed one tree level at a time, so the only Python loops
-    run over rotation orders and tree depth, never over frames.
+    One compiled pass: each frame walks the joints in index order (parents
+    first), building each local rotation from its Euler angles and composing it
+    with its parent's world pose.
 
     Parameters
     ----------
@@ -106,36 +99,18 @@ def forward_kinematics(skeleton, channels):
     channels = _check_channels(skeleton, channels)
     plan = _channel_plan(skeleton)
     n_frames, n_joints = channels.shape[0], skeleton.n_joints
-
-    # Joint-major arrays, (n_joints, n_frames, ...): a tree level is then a gather
-    # of whole per-joint blocks rather than a strided gather across frames.
-    angles = np.zeros((n_joints, n_frames, 3))
-    cols, joints, slots = plan["rot"]
-    angles[joints, :, slots] = channels[:, cols].T
-    local = np.empty((n_joints, n_frames, 3, 3))
-    local[:] = np.eye(3)
-    for order, idx in plan["by_order"].items():
-        local[idx] = euler_to_matrix(angles[idx], order)
-    if skeleton.axes is not None:
-        axes = np.asarray(skeleton.axes)[:, None]
-        local = axes @ local @ np.swapaxes(axes, -1, -2)
-
-    translations = np.empty((n_joints, n_frames, 3))
-    translations[:] = np.asarray(skeleton.offsets)[:, None, :]
-    cols, joints, axis = plan["pos"]
-    translations[joints, :, axis] = channels[:, cols].T
-
-    rotations = np.empty_like(local)
-    positions = np.empty_like(translations)
-    rotations[0] = local[0]
-    positions[0] = translations[0]
-    parents = plan["parents"]
-    for idx in plan["levels"]:
-        parent_rot = rotations[parents[idx]]
-        rotations[idx] = parent_rot @ local[idx]
-        positions[idx] = (
-            positions[parents[idx]] + (parent_rot @ translations[idx][..., None])[..., 0]
-        )
-    positions = np.ascontiguousarray(positions.transpose(1, 0, 2))
-    rotations = np.ascontiguousarray(rotations.transpose(1, 0, 2, 3))
+    rotations = np.empty((n_frames, n_joints, 3, 3))
+    positions = np.empty((n_frames, n_joints, 3))
+    forward_pass(
+        np.ascontiguousarray(channels),
+        plan["rotation_column"],
+        plan["axis_of_slot"],
+        plan["position_column"],
+        plan["offsets"],
+        plan["axes"],
+        skeleton.axes is not None,
+        plan["parents"],
+        rotations,
+        positions,
+    )
     return FKResult(positions, rotations)

@@ -15,12 +15,16 @@ from skmotion.kinematics import Skeleton
 from skmotion.kinematics._layouts import Layout
 from skmotion.preprocessing import VirtualMarkerTransform
 from skmotion.tree import MotionTreeEncoder
+from skmotion.tree._build import TREE_CONSTRAINTS
 from skmotion.tree._calibration import mixture_novelty
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
 __all__ = ["MotionClassifier", "block_scales"]
+
+# Fewer clips than this share of the columns: the linear model is solved in their span.
+_SPAN_SHARE = 0.25
 
 
 def block_scales(frames, blocks, weights):
@@ -60,6 +64,52 @@ def block_scales(frames, blocks, weights):
         spread = np.sqrt(np.mean(np.square(deviation[:, columns]))) if columns.any() else 0.0
         scale[columns] = (spread if spread > 0 else 1.0) / weight
     return scale
+
+
+def fit_in_span(model, columns, y):
+    """Fit an L2-penalised linear ``model`` in the span of the training rows, when they are few.
+
+    The gradient of the loss and of the L2 penalty with respect to the weights
+    is a combination of the rows, so the optimal weights are one too (the
+    representer theorem): with ``n`` rows and ``d >> n`` columns the problem is
+    solved on the rows' ``r <= n`` coordinates in an orthonormal basis of their
+    span (the right singular vectors), whose penalty is the same, and the
+    weights are mapped back. The same optimum, with ``r`` instead of ``d``
+    unknowns per class; with ``n > d / 4`` the basis costs more than it saves
+    and the model is fitted as it is.
+
+    Parameters
+    ----------
+    model : LogisticRegression
+        Unfitted, with an L2 penalty (or none) and an unpenalised intercept.
+    columns : ndarray of shape (n_samples, n_features)
+    y : ndarray of shape (n_samples,)
+
+    Returns
+    -------
+    model : LogisticRegression
+        Fitted; its ``coef_`` of shape (n_classes or 1, n_features) acts on ``columns``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from sklearn.linear_model import LogisticRegression
+    >>> rng = np.random.default_rng(0)
+    >>> X, y = rng.normal(size=(20, 200)), np.repeat([0, 1], 10)
+    >>> full = LogisticRegression(tol=1e-12, max_iter=10_000).fit(X, y)
+    >>> span = fit_in_span(LogisticRegression(tol=1e-12, max_iter=10_000), X, y)
+    >>> bool(np.allclose(span.coef_, full.coef_, atol=1e-6))
+    True
+    """
+    n_samples, n_features = columns.shape
+    if n_samples > _SPAN_SHARE * n_features:
+        return model.fit(columns, y)
+    _, values, rows = np.linalg.svd(columns, full_matrices=False)
+    basis = rows[values > values[0] * n_features * np.finfo(float).eps].T
+    model.fit(columns @ basis, y)
+    model.coef_ = model.coef_ @ basis.T
+    model.n_features_in_ = n_features
+    return model
 
 
 class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
@@ -116,6 +166,9 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
     max_depth : int, default=6
         The motion tree's deepest layer (its vocabulary: up to ``2 ** max_depth``
         poses).
+    split : {"median", "two_means", "min_error"}, default="median"
+        How the motion tree splits a node along its principal axis (see
+        :class:`~skmotion.tree.MotionTreeEncoder`).
     residual_layers : array-like of int, default=(1, 3)
         The tree layers whose residuals are encoded.
     moment_pyramid : array-like of int, default=(1, 2, 4)
@@ -126,6 +179,10 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         their own units.
     C : float, default=1.0
         Inverse regularisation of the logistic regression.
+    class_weight : "balanced", dict or None, default=None
+        The logistic regression's class weights: ``"balanced"`` weighs each
+        class inversely to its number of training clips (for classes recorded
+        unevenly), None weighs every clip alike.
     n_jobs : int, default=None
         Clips turned into markers in parallel (joblib threads).
     verbose : int, default=0
@@ -180,10 +237,12 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         "scaling": [StrOptions({"auto", "blocks", "channels"})],
         "velocity_weight": [Interval(Real, 0, None, closed="neither")],
         "max_depth": [Interval(Integral, 1, None, closed="left")],
+        "split": TREE_CONSTRAINTS["split"],
         "residual_layers": ["array-like"],
         "moment_pyramid": ["array-like"],
         "column_power": [Interval(Real, 0, 1, closed="both")],
         "C": [Interval(Real, 0, None, closed="neither")],
+        "class_weight": [StrOptions({"balanced"}), dict, None],
         "n_jobs": [Integral, None],
         "verbose": ["verbose"],
     }
@@ -199,10 +258,12 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         scaling="auto",
         velocity_weight=1.0,
         max_depth=6,
+        split="median",
         residual_layers=(1, 3),
         moment_pyramid=(1, 2, 4),
         column_power=0.5,
         C=1.0,
+        class_weight=None,
         n_jobs=None,
         verbose=0,
     ):
@@ -213,10 +274,12 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.scaling = scaling
         self.velocity_weight = velocity_weight
         self.max_depth = max_depth
+        self.split = split
         self.residual_layers = residual_layers
         self.moment_pyramid = moment_pyramid
         self.column_power = column_power
         self.C = C
+        self.class_weight = class_weight
         self.n_jobs = n_jobs
         self.verbose = verbose
 
@@ -266,6 +329,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         say(self.verbose, f"MotionClassifier: the vocabulary over {len(frames):,} frames")
         self.encoder_ = MotionTreeEncoder(
             max_depth=self.max_depth,
+            split=self.split,
             layers="all",
             residual_layers=self.residual_layers,
             moment_pyramid=self.moment_pyramid,
@@ -278,9 +342,10 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.column_center_ = columns.mean_
         self.column_scale_ = columns.scale_**self.column_power
         say(self.verbose, f"MotionClassifier: the classifier on {features.shape[1]} columns")
-        self.classifier_ = LogisticRegression(C=self.C, max_iter=1000).fit(
-            self._columns(features), y
-        )
+        # With fewer clips than columns (sets of tens of clips), the same optimum in
+        # the clips' span costs a third of the time (fit_in_span)
+        linear = LogisticRegression(C=self.C, class_weight=self.class_weight, max_iter=1000)
+        self.classifier_ = fit_in_span(linear, self._columns(features), y)
         self.classes_ = self.classifier_.classes_
         return self
 

@@ -192,6 +192,35 @@ def test_random_orders_and_axes_match_reference(order, angles, with_axis):
     np.testing.assert_allclose(fk.rotations, rotations, atol=1e-12)
 
 
+@given(st.integers(0, 2**32 - 1))
+def test_any_channel_subset_tree_matches_reference(seed):
+    """Random trees whose joints carry any subset of rotation and position channels,
+    in any listed order, with random rotation orders and bone axes."""
+    rng = np.random.default_rng(seed)
+    n_joints = int(rng.integers(1, 7))
+    parents = [-1] + [int(rng.integers(0, j)) for j in range(1, n_joints)]
+    channels = []
+    for _ in range(n_joints):
+        names = [f"{a}rotation" for a in "XYZ"] + [f"{a}position" for a in "XYZ"]
+        channels.append([names[i] for i in rng.permutation(6)[: int(rng.integers(0, 7))]])
+    axes = None
+    if rng.random() < 0.5:
+        axes = euler_to_matrix(rng.uniform(-np.pi, np.pi, size=(n_joints, 3)), "XYZ")
+    sk = Skeleton(
+        [f"j{j}" for j in range(n_joints)],
+        parents,
+        rng.normal(size=(n_joints, 3)),
+        channels,
+        rotation_orders=["".join(rng.permutation(list("XYZ"))) for _ in range(n_joints)],
+        axes=axes,
+    )
+    values = rng.uniform(-np.pi, np.pi, size=(4, sk.n_channels))
+    positions, rotations = slow_forward_kinematics(sk, values)
+    fk = forward_kinematics(sk, values)
+    np.testing.assert_allclose(fk.positions, positions, atol=1e-12)
+    np.testing.assert_allclose(fk.rotations, rotations, atol=1e-12)
+
+
 def test_rotations_are_proper(skeleton, rng):
     fk = forward_kinematics(skeleton, rng.normal(size=(30, skeleton.n_channels)))
     gram = np.einsum("fjab,fjac->fjbc", fk.rotations, fk.rotations)

@@ -16,6 +16,7 @@ from sklearn.preprocessing import StandardScaler
 from skmotion.datasets import make_motions, make_position_motions
 from skmotion.preprocessing import FlattenClips, ResampleClips, VirtualMarkerTransform
 from skmotion.recognition import MotionClassifier, block_scales
+from skmotion.recognition._motion_classifier import fit_in_span
 from skmotion.tree import MotionTreeEncoder
 from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
 
@@ -71,13 +72,80 @@ def test_equals_its_steps_run_by_hand(positions):
     Ftr, Fte = encoder.transform(S(Mtr)), encoder.transform(S(Mte))
     # each column centred and divided by the square root of its standard deviation
     root = lambda F: (F - Ftr.mean(axis=0)) / np.sqrt(Ftr.std(axis=0))  # noqa: E731
-    head = LogisticRegression(C=1.0, max_iter=1000).fit(root(Ftr), ytr)
-    np.testing.assert_allclose(model.predict_proba(Xte), head.predict_proba(root(Fte)), atol=1e-10)
+    assert len(Ftr) <= Ftr.shape[1] / 4  # few clips: the model is solved in their span
+    span = _span(root(Ftr))
+    head = LogisticRegression(C=1.0, max_iter=1000).fit(root(Ftr) @ span, ytr)
+    np.testing.assert_allclose(
+        model.predict_proba(Xte), head.predict_proba(root(Fte) @ span), atol=1e-10
+    )
     # column_power=1 is sklearn's StandardScaler
     standard = clone(model).set_params(column_power=1.0).fit(Xtr, ytr)
-    head = make_pipeline(StandardScaler(), LogisticRegression(C=1.0, max_iter=1000))
-    head.fit(Ftr, ytr)
-    np.testing.assert_allclose(standard.predict_proba(Xte), head.predict_proba(Fte), atol=1e-10)
+    scaler = StandardScaler().fit(Ftr)
+    span = _span(scaler.transform(Ftr))
+    head = LogisticRegression(C=1.0, max_iter=1000).fit(scaler.transform(Ftr) @ span, ytr)
+    np.testing.assert_allclose(
+        standard.predict_proba(Xte), head.predict_proba(scaler.transform(Fte) @ span), atol=1e-10
+    )
+
+
+def _span(columns):
+    """An orthonormal basis of the rows' span: the right singular vectors of nonzero values."""
+    _, values, rows = np.linalg.svd(columns, full_matrices=False)
+    return rows[values > values[0] * columns.shape[1] * np.finfo(float).eps].T
+
+
+@pytest.mark.parametrize("n_classes", [2, 4])
+@pytest.mark.parametrize("class_weight", [None, "balanced"])
+def test_the_span_gives_the_full_problems_optimum(n_classes, class_weight):
+    """Solved in the span of 30 rows, the weights over 400 columns are the full problem's."""
+    rng = np.random.default_rng(n_classes)
+    X = rng.normal(size=(30, 400))
+    y = rng.integers(0, n_classes, size=30)
+    y[:n_classes] = np.arange(n_classes)
+    X[:, :5] += y[:, None]
+    tight = dict(C=0.5, class_weight=class_weight, tol=1e-12, max_iter=100_000)
+    full = LogisticRegression(**tight).fit(X, y)
+    span = fit_in_span(LogisticRegression(**tight), X, y)
+    assert span.coef_.shape == full.coef_.shape and span.n_features_in_ == 400
+    np.testing.assert_allclose(span.coef_, full.coef_, atol=1e-7)
+    np.testing.assert_allclose(span.intercept_, full.intercept_, atol=1e-7)
+    Z = rng.normal(size=(10, 400))
+    np.testing.assert_allclose(span.predict_proba(Z), full.predict_proba(Z), atol=1e-7)
+    # many rows: the model is fitted on the columns as they are (no basis)
+    many = rng.normal(size=(120, 400)), rng.integers(0, n_classes, size=120)
+    direct = LogisticRegression(C=0.5, class_weight=class_weight, max_iter=1000).fit(*many)
+    same = fit_in_span(LogisticRegression(C=0.5, class_weight=class_weight, max_iter=1000), *many)
+    np.testing.assert_array_equal(same.coef_, direct.coef_)
+
+
+def test_split_and_class_weight_reach_their_steps():
+    """``split`` is the tree's and ``class_weight`` the logistic regression's: the same
+    answers as the steps run by hand with them, on classes recorded unevenly."""
+    X, y = small_clips()
+    keep = np.flatnonzero((y != "wave") | (np.arange(len(y)) % 3 == 0))
+    X, y = [X[i] for i in keep], y[keep]
+    assert (y == "wave").sum() == 1 and len(y) == 7
+    params = {"max_depth": 3, "split": "two_means", "class_weight": "balanced"}
+    model = MotionClassifier(**params).fit(X, y)
+    frames = np.vstack(X)
+    scaled = [(x - frames.mean(axis=0)) / frames.std(axis=0) for x in X]
+    encoder = MotionTreeEncoder(
+        max_depth=3,
+        split="two_means",
+        layers="all",
+        moment_pyramid=(1, 2, 4),
+        standardize=False,
+        sparse_output=False,
+    ).fit(scaled)
+    F = encoder.transform(scaled)
+    spread = F.std(axis=0)
+    root = (F - F.mean(axis=0)) / np.sqrt(np.where(spread > 0, spread, 1.0))
+    span = _span(root)
+    head = LogisticRegression(C=1.0, class_weight="balanced", max_iter=1000).fit(root @ span, y)
+    np.testing.assert_allclose(model.predict_proba(X), head.predict_proba(root @ span), atol=1e-10)
+    # balanced: the one wave clip weighs 7 / (3 * 1), each other clip 7 / (3 * 3)
+    unweighted = clone(model).set_params(class_weight=None).fit(X, y)
+    assert not np.allclose(unweighted.predict_proba(X), model.predict_proba(X))
 
 
 def test_beats_nearest_neighbour_on_a_held_out_subject(positions):
@@ -150,6 +218,8 @@ def test_plain_channels_are_standardised_one_by_one():
         ({"C": 0.0}, "C"),
         ({"column_power": 1.5}, "column_power"),
         ({"scaling": "per-channel"}, "scaling"),
+        ({"split": "mean"}, "split"),
+        ({"class_weight": "even"}, "class_weight"),
     ],
 )
 def test_bad_parameters_are_named(params, match):
