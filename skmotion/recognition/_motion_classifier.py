@@ -133,7 +133,9 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
        trajectory) with its root mean square;
     4. **classifier** -- each column centred and divided by the square root of
        its spread (``column_power``), then a multinomial logistic regression
-       (``C``), whose probabilities are the answer of :meth:`predict_proba`.
+       (``C``, ``class_weight``), whose probabilities are the answer of
+       :meth:`predict_proba`; with fewer clips than a quarter of the columns it is
+       solved in the clips' span (the same optimum, see ``fit_in_span``).
        Full standardisation would give a leaf that a few training frames
        reach the weight of the commonest pose; no scaling would leave the
        occupancies (shares of frames) far quieter than the channel means. The
