@@ -12,6 +12,7 @@ import numpy as np
 from _common import SHARED_DATA
 from _msrc12 import msrc12_takes
 from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.ensemble import VotingClassifier
 from sklearn.linear_model import LogisticRegression, RidgeClassifierCV
 from sklearn.model_selection import GroupKFold
 from sklearn.pipeline import make_pipeline
@@ -306,9 +307,23 @@ def figure(detectors, take, points, gesture, path):
     plt.close(fig)
 
 
-SWITCH_PENALTIES = (0.0, 10.0, 30.0, 100.0, 300.0, 1000.0, 3000.0)  # ActivitySegmenter's grid
-# the recogniser's defaults, and the standardised columns it had before its defaults study
-RECOGNISER_GRID = ({}, {"recognizer__column_power": 1.0, "recognizer__C": 0.1})
+SWITCH_PENALTIES = (0.0, 10.0, 30.0, 100.0, 200.0, 300.0, 500.0, 700.0, 1000.0, 1500.0, 3000.0)
+# the recogniser's settings: its defaults, and the standardised columns it had before its
+# defaults study; the labelling chooses one of them or both averaged (soft voting)
+RECOGNISER_SETTINGS = {
+    "defaults": {},
+    "standardised columns, C=0.1": {"column_power": 1.0, "C": 0.1},
+}
+RECOGNISER_CHOICES = (("defaults",), ("standardised columns, C=0.1",), tuple(RECOGNISER_SETTINGS))
+
+
+def labelling_recogniser(choice):
+    """A MotionClassifier of one setting, or sklearn's soft vote (mean probabilities) of several."""
+    members = [
+        (name, MotionClassifier(layout="kinect_v1", frame_rate=RATE, **RECOGNISER_SETTINGS[name]))
+        for name in choice
+    ]
+    return members[0][1] if len(members) == 1 else VotingClassifier(members, voting="soft")
 
 
 def concatenated_takes(takes, gestures, people, idx, seed=0):
@@ -336,23 +351,28 @@ def _path_accuracy(probas, truth, classes, penalty):
 
 
 def _choose_recogniser_and_penalty(segmenter, takes, gestures, people, train):
-    """The recogniser's setting (of RECOGNISER_GRID) and the switch penalty of the best frame
-    accuracy on out-of-fold concatenated takes of the training people (GroupKFold(3) over
-    them): the test people never enter the choice."""
-    hits = np.zeros((len(RECOGNISER_GRID), len(SWITCH_PENALTIES)))
+    """The recogniser (of RECOGNISER_CHOICES) and the switch penalty of the best frame accuracy
+    on out-of-fold concatenated takes of the training people (GroupKFold(3) over them): the
+    test people never enter the choice. Each setting is fitted once per fold; a soft vote's
+    frame probabilities are the mean of its members' (a frame's probabilities are a mean of
+    window probabilities, so averaging the members' frames is averaging their windows)."""
+    hits, n_frames = np.zeros((len(RECOGNISER_CHOICES), len(SWITCH_PENALTIES))), 0
     for fit_idx, held in GroupKFold(3).split(train, groups=people[train]):
         fit_idx, held = train[fit_idx], train[held]
         long_takes, truth = concatenated_takes(takes, gestures, people, held)
-        n_frames = sum(len(t) for t in truth)
-        for i, params in enumerate(RECOGNISER_GRID):
-            model = clone(segmenter).set_params(**params)
+        n_frames += sum(len(t) for t in truth)
+        probas = {}
+        for name in RECOGNISER_SETTINGS:
+            model = clone(segmenter).set_params(recognizer=labelling_recogniser((name,)))
             model.fit([takes[k] for k in fit_idx], gestures[fit_idx])
-            probas = model.predict_proba_frames(long_takes)
+            probas[name] = model.predict_proba_frames(long_takes)
+        for i, choice in enumerate(RECOGNISER_CHOICES):
+            mean = [np.mean(frames, axis=0) for frames in zip(*(probas[n] for n in choice))]
             for j, penalty in enumerate(SWITCH_PENALTIES):
-                accuracy = _path_accuracy(probas, truth, model.classes_, penalty)[0]
-                hits[i, j] += accuracy * n_frames
+                accuracy = _path_accuracy(mean, truth, model.classes_, penalty)[0]
+                hits[i, j] += accuracy * sum(len(t) for t in truth)
     i, j = np.unravel_index(int(np.argmax(hits)), hits.shape)
-    return RECOGNISER_GRID[i], SWITCH_PENALTIES[j]
+    return RECOGNISER_CHOICES[i], SWITCH_PENALTIES[j], hits[i, j] / n_frames
 
 
 def labelling(quick, window=60):
@@ -360,9 +380,9 @@ def labelling(quick, window=60):
 
     Four takes of one held-out person end to end (mostly different gestures);
     every frame's truth is the gesture of its take. The recogniser is the
-    recommended MotionClassifier on windows of ``window`` frames (4 s); its column
-    scaling and C (RECOGNISER_GRID: its defaults, or standardised columns) and the
-    switch penalty are chosen by GroupKFold(3) over the training people; the frames'
+    recommended MotionClassifier on windows of ``window`` frames (4 s): its defaults,
+    its former standardised columns, or both averaged (RECOGNISER_CHOICES); that and
+    the switch penalty are chosen by GroupKFold(3) over the training people; the frames'
     labels without the path (penalty 0) are given beside it, from the same probabilities.
     """
     takes, _, gestures, people = msrc12()
@@ -372,13 +392,14 @@ def labelling(quick, window=60):
         train, test = train[::6], test[::6]
     long_takes, truth = concatenated_takes(takes, gestures, people, test)
     frames = int(sum(len(t) for t in long_takes))
-    recogniser = MotionClassifier(layout="kinect_v1", frame_rate=RATE)
-    segmenter = ActivitySegmenter(recogniser, window=window, step=5, train_step=15)
+    segmenter = ActivitySegmenter(window=window, step=5, train_step=15)
     start = time.perf_counter()
-    params, penalty = _choose_recogniser_and_penalty(segmenter, takes, gestures, people, train)
+    choice, penalty, cv_accuracy = _choose_recogniser_and_penalty(
+        segmenter, takes, gestures, people, train
+    )
     cv_s = time.perf_counter() - start
     start = time.perf_counter()
-    segmenter.set_params(switch_penalty=penalty, **params)
+    segmenter.set_params(switch_penalty=penalty, recognizer=labelling_recogniser(choice))
     segmenter.fit([takes[i] for i in train], gestures[train])
     fit_s = time.perf_counter() - start
     start = time.perf_counter()
@@ -392,13 +413,13 @@ def labelling(quick, window=60):
     rows = []
     for name, labels, acc, chosen in (
         (
-            f"MotionClassifier windows {params or '(defaults)'}, best path (by CV)",
+            f"MotionClassifier windows ({' + '.join(choice)}), best path (by CV)",
             predicted,
             accuracy,
             penalty,
         ),
         (
-            f"MotionClassifier windows {params or '(defaults)'}, most probable class per frame",
+            f"MotionClassifier windows ({' + '.join(choice)}), most probable class per frame",
             plain_labels,
             plain,
             0.0,
@@ -412,6 +433,7 @@ def labelling(quick, window=60):
                 "frame accuracy": acc,
                 "segments per take (true: 4)": float(np.mean([len(runs(p)) for p in labels])),
                 "switch penalty": chosen,
+                "out-of-fold accuracy of the choice (training people)": cv_accuracy,
                 "fit s": fit_s,
                 "penalty CV s": cv_s,
                 "us per frame (batch)": 1e6 * predict_s / frames,
