@@ -32,7 +32,9 @@ LABELLING_FIGURE = FIGURE.with_name("live_labelling.png")
 LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
 THRESHOLDS = np.r_[np.round(np.linspace(0.05, 0.95, 19), 2), 0.97, 0.99]
 REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
-LINEAR_C = (0.1,)  # LinearGestureDetector's C grid (chosen by the same GroupKFold when longer)
+# LinearGestureDetector's settings, chosen with the event rule by the same GroupKFold: the
+# segment length (6 frames: a 2 s window as the others'; 4: 1.3 s), C fixed at 0.1
+LINEAR_GRID = ({"segment": 6}, {"segment": 4})
 GESTURES = (
     "lift arms", "duck", "push right", "goggles", "wind it up", "shoot",
     "bow", "throw", "had enough", "change weapon", "beat both", "kick",
@@ -180,15 +182,15 @@ def detectors(step, window, chosen=None):
         for name, recogniser in recognisers().items()
     }
     # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size)
-    # negatives: 80 windows per take ending anywhere more than `jitter` (1) frame from an
-    # action point, so that the score peaks at the completion and not before or after it
+    # negatives: 80 windows per take ending anywhere more than one frame from a positive
+    # end (action point +- 1), so that the score peaks at the completion, not before or after
     found[LINEAR] = LinearGestureDetector(
         n_segments=5,
         segment=window // 5,
         root=0,
         size_joints=(0, 2),
         n_negatives=80,
-        negative_gap=0,
+        negative_gap=1,
         random_state=0,
     )
     if chosen:
@@ -208,8 +210,8 @@ def detection(quick, step=2, window=30, chosen=None):
     rows, fitted = [], {}
     for name, detector in detectors(step, window, chosen).items():
         start = time.perf_counter()
-        # the linear detector's regularisation is chosen with its event rule, on the same folds
-        grid = [{"C": c} for c in LINEAR_C] if isinstance(detector, LinearGestureDetector) else [{}]
+        # the linear detector's setting is chosen with its event rule, on the same folds
+        grid = LINEAR_GRID if isinstance(detector, LinearGestureDetector) else [{}]
         found = []
         for extra in grid:
             f1, rule = _choose(
@@ -248,8 +250,11 @@ def detection(quick, step=2, window=30, chosen=None):
                         "trigger (CV)": rule["trigger"],
                         "threshold (CV)": rule["threshold"],
                         "refractory frames (CV)": rule["refractory"],
-                        "C (CV)": rule.get("C", ""),
+                        "segment frames (CV)": rule.get("segment", ""),
                         "CV F1 at 0.5 s": cv_f1,
+                        "CV F1 at 0.5 s of each setting": "; ".join(
+                            f"{extra or 'as is'}: {f1:.3f}" for (f1, _), extra in zip(found, grid)
+                        ),
                         "stream events = batch": same,
                         "us per frame, one per call": per_call,
                         "us per call, median": median_call,
