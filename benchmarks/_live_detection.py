@@ -12,6 +12,7 @@ import numpy as np
 from _common import SHARED_DATA
 from _msrc12 import msrc12_takes
 from sklearn.base import BaseEstimator, ClassifierMixin, clone
+from sklearn.ensemble import VotingClassifier
 from sklearn.linear_model import LogisticRegression, RidgeClassifierCV
 from sklearn.model_selection import GroupKFold
 from sklearn.pipeline import make_pipeline
@@ -31,7 +32,10 @@ LABELLING_FIGURE = FIGURE.with_name("live_labelling.png")
 LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
 THRESHOLDS = np.r_[np.round(np.linspace(0.05, 0.95, 19), 2), 0.97, 0.99]
 REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
-LINEAR_C = (0.1,)  # LinearGestureDetector's C grid (chosen by the same GroupKFold when longer)
+# LinearGestureDetector's settings, chosen with the event rule by the same GroupKFold: segments
+# of 4 frames (a 1.3 s window; 3 and 6 frames and 4 segments of 4 gave less out-of-fold F1 on
+# half the training takes) and the regularisation C
+LINEAR_GRID = ({"segment": 4, "C": 0.1}, {"segment": 4, "C": 0.03}, {"segment": 4, "C": 0.01})
 GESTURES = (
     "lift arms", "duck", "push right", "goggles", "wind it up", "shoot",
     "bow", "throw", "had enough", "change weapon", "beat both", "kick",
@@ -179,15 +183,15 @@ def detectors(step, window, chosen=None):
         for name, recogniser in recognisers().items()
     }
     # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size)
-    # negatives: 80 windows per take ending anywhere more than `jitter` (1) frame from an
-    # action point, so that the score peaks at the completion and not before or after it
+    # negatives: 80 windows per take ending anywhere more than one frame from a positive
+    # end (action point +- 1), so that the score peaks at the completion, not before or after
     found[LINEAR] = LinearGestureDetector(
         n_segments=5,
         segment=window // 5,
         root=0,
         size_joints=(0, 2),
         n_negatives=80,
-        negative_gap=0,
+        negative_gap=1,
         random_state=0,
     )
     if chosen:
@@ -207,8 +211,8 @@ def detection(quick, step=2, window=30, chosen=None):
     rows, fitted = [], {}
     for name, detector in detectors(step, window, chosen).items():
         start = time.perf_counter()
-        # the linear detector's regularisation is chosen with its event rule, on the same folds
-        grid = [{"C": c} for c in LINEAR_C] if isinstance(detector, LinearGestureDetector) else [{}]
+        # the linear detector's setting is chosen with its event rule, on the same folds
+        grid = LINEAR_GRID if isinstance(detector, LinearGestureDetector) else [{}]
         found = []
         for extra in grid:
             f1, rule = _choose(
@@ -247,8 +251,12 @@ def detection(quick, step=2, window=30, chosen=None):
                         "trigger (CV)": rule["trigger"],
                         "threshold (CV)": rule["threshold"],
                         "refractory frames (CV)": rule["refractory"],
+                        "segment frames (CV)": rule.get("segment", ""),
                         "C (CV)": rule.get("C", ""),
                         "CV F1 at 0.5 s": cv_f1,
+                        "CV F1 at 0.5 s of each setting": "; ".join(
+                            f"{extra or 'as is'}: {f1:.3f}" for (f1, _), extra in zip(found, grid)
+                        ),
                         "stream events = batch": same,
                         "us per frame, one per call": per_call,
                         "us per call, median": median_call,
@@ -306,9 +314,23 @@ def figure(detectors, take, points, gesture, path):
     plt.close(fig)
 
 
-SWITCH_PENALTIES = (0.0, 10.0, 30.0, 100.0, 300.0, 1000.0, 3000.0)  # ActivitySegmenter's grid
-# the recogniser's defaults, and the standardised columns it had before its defaults study
-RECOGNISER_GRID = ({}, {"recognizer__column_power": 1.0, "recognizer__C": 0.1})
+SWITCH_PENALTIES = (0.0, 10.0, 30.0, 100.0, 200.0, 300.0, 500.0, 700.0, 1000.0, 1500.0, 3000.0)
+# the recogniser's settings: its defaults, and the standardised columns it had before its
+# defaults study; the labelling chooses one of them or both averaged (soft voting)
+RECOGNISER_SETTINGS = {
+    "defaults": {},
+    "standardised columns, C=0.1": {"column_power": 1.0, "C": 0.1},
+}
+RECOGNISER_CHOICES = (("defaults",), ("standardised columns, C=0.1",), tuple(RECOGNISER_SETTINGS))
+
+
+def labelling_recogniser(choice):
+    """A MotionClassifier of one setting, or sklearn's soft vote (mean probabilities) of several."""
+    members = [
+        (name, MotionClassifier(layout="kinect_v1", frame_rate=RATE, **RECOGNISER_SETTINGS[name]))
+        for name in choice
+    ]
+    return members[0][1] if len(members) == 1 else VotingClassifier(members, voting="soft")
 
 
 def concatenated_takes(takes, gestures, people, idx, seed=0):
@@ -336,23 +358,28 @@ def _path_accuracy(probas, truth, classes, penalty):
 
 
 def _choose_recogniser_and_penalty(segmenter, takes, gestures, people, train):
-    """The recogniser's setting (of RECOGNISER_GRID) and the switch penalty of the best frame
-    accuracy on out-of-fold concatenated takes of the training people (GroupKFold(3) over
-    them): the test people never enter the choice."""
-    hits = np.zeros((len(RECOGNISER_GRID), len(SWITCH_PENALTIES)))
+    """The recogniser (of RECOGNISER_CHOICES) and the switch penalty of the best frame accuracy
+    on out-of-fold concatenated takes of the training people (GroupKFold(3) over them): the
+    test people never enter the choice. Each setting is fitted once per fold; a soft vote's
+    frame probabilities are the mean of its members' (a frame's probabilities are a mean of
+    window probabilities, so averaging the members' frames is averaging their windows)."""
+    hits, n_frames = np.zeros((len(RECOGNISER_CHOICES), len(SWITCH_PENALTIES))), 0
     for fit_idx, held in GroupKFold(3).split(train, groups=people[train]):
         fit_idx, held = train[fit_idx], train[held]
         long_takes, truth = concatenated_takes(takes, gestures, people, held)
-        n_frames = sum(len(t) for t in truth)
-        for i, params in enumerate(RECOGNISER_GRID):
-            model = clone(segmenter).set_params(**params)
+        n_frames += sum(len(t) for t in truth)
+        probas = {}
+        for name in RECOGNISER_SETTINGS:
+            model = clone(segmenter).set_params(recognizer=labelling_recogniser((name,)))
             model.fit([takes[k] for k in fit_idx], gestures[fit_idx])
-            probas = model.predict_proba_frames(long_takes)
+            probas[name] = model.predict_proba_frames(long_takes)
+        for i, choice in enumerate(RECOGNISER_CHOICES):
+            mean = [np.mean(frames, axis=0) for frames in zip(*(probas[n] for n in choice))]
             for j, penalty in enumerate(SWITCH_PENALTIES):
-                accuracy = _path_accuracy(probas, truth, model.classes_, penalty)[0]
-                hits[i, j] += accuracy * n_frames
+                accuracy = _path_accuracy(mean, truth, model.classes_, penalty)[0]
+                hits[i, j] += accuracy * sum(len(t) for t in truth)
     i, j = np.unravel_index(int(np.argmax(hits)), hits.shape)
-    return RECOGNISER_GRID[i], SWITCH_PENALTIES[j]
+    return RECOGNISER_CHOICES[i], SWITCH_PENALTIES[j], hits[i, j] / n_frames
 
 
 def labelling(quick, window=60):
@@ -360,9 +387,9 @@ def labelling(quick, window=60):
 
     Four takes of one held-out person end to end (mostly different gestures);
     every frame's truth is the gesture of its take. The recogniser is the
-    recommended MotionClassifier on windows of ``window`` frames (4 s); its column
-    scaling and C (RECOGNISER_GRID: its defaults, or standardised columns) and the
-    switch penalty are chosen by GroupKFold(3) over the training people; the frames'
+    recommended MotionClassifier on windows of ``window`` frames (4 s): its defaults,
+    its former standardised columns, or both averaged (RECOGNISER_CHOICES); that and
+    the switch penalty are chosen by GroupKFold(3) over the training people; the frames'
     labels without the path (penalty 0) are given beside it, from the same probabilities.
     """
     takes, _, gestures, people = msrc12()
@@ -372,13 +399,14 @@ def labelling(quick, window=60):
         train, test = train[::6], test[::6]
     long_takes, truth = concatenated_takes(takes, gestures, people, test)
     frames = int(sum(len(t) for t in long_takes))
-    recogniser = MotionClassifier(layout="kinect_v1", frame_rate=RATE)
-    segmenter = ActivitySegmenter(recogniser, window=window, step=5, train_step=15)
+    segmenter = ActivitySegmenter(window=window, step=5, train_step=15)
     start = time.perf_counter()
-    params, penalty = _choose_recogniser_and_penalty(segmenter, takes, gestures, people, train)
+    choice, penalty, cv_accuracy = _choose_recogniser_and_penalty(
+        segmenter, takes, gestures, people, train
+    )
     cv_s = time.perf_counter() - start
     start = time.perf_counter()
-    segmenter.set_params(switch_penalty=penalty, **params)
+    segmenter.set_params(switch_penalty=penalty, recognizer=labelling_recogniser(choice))
     segmenter.fit([takes[i] for i in train], gestures[train])
     fit_s = time.perf_counter() - start
     start = time.perf_counter()
@@ -392,13 +420,13 @@ def labelling(quick, window=60):
     rows = []
     for name, labels, acc, chosen in (
         (
-            f"MotionClassifier windows {params or '(defaults)'}, best path (by CV)",
+            f"MotionClassifier windows ({' + '.join(choice)}), best path (by CV)",
             predicted,
             accuracy,
             penalty,
         ),
         (
-            f"MotionClassifier windows {params or '(defaults)'}, most probable class per frame",
+            f"MotionClassifier windows ({' + '.join(choice)}), most probable class per frame",
             plain_labels,
             plain,
             0.0,
@@ -412,6 +440,7 @@ def labelling(quick, window=60):
                 "frame accuracy": acc,
                 "segments per take (true: 4)": float(np.mean([len(runs(p)) for p in labels])),
                 "switch penalty": chosen,
+                "out-of-fold accuracy of the choice (training people)": cv_accuracy,
                 "fit s": fit_s,
                 "penalty CV s": cv_s,
                 "us per frame (batch)": 1e6 * predict_s / frames,

@@ -27,9 +27,10 @@ Result tables, all measured in one run:
   event rule chosen by GroupKFold over the training people; microseconds per
   frame, one frame per call and batched (``_live_detection.py``).
 - ``live_labelling`` (MSRC-12): frame accuracy of ``ActivitySegmenter`` (windows
-  of ``MotionClassifier``, the switch penalty chosen by GroupKFold over the
-  training people) on held-out takes of one person concatenated four at a
-  time, with and without the best label path; a figure of one long take.
+  of ``MotionClassifier``: its defaults, its standardised columns or both averaged,
+  chosen with the switch penalty by GroupKFold over the training people) on
+  held-out takes of one person concatenated four at a time, with and without the
+  best label path; a figure of one long take.
 - ``live_stream_cost``: microseconds per frame of ``stream().update`` on a clip
   of 32 virtual markers (192 channels), for the exact stream (window of 30
   frames, or all frames) and the online one, against the chunk size; the ratio
@@ -637,7 +638,9 @@ def main():
     msrc_note = (
         "MSRC-12, odd people train, even people test; trigger, threshold and refractory period by "
         "GroupKFold(3) over the training people (out-of-fold F1 at 0.5 s). Detection: window "
-        "30 frames (2 s), step 2; labelling: window 60 frames (4 s), step 5. F1: one event "
+        "30 frames (2 s), step 2 (the linear detector: every frame, its segment length and C "
+        "by the same CV); labelling: window 60 frames (4 s), step 5, the recogniser and the "
+        "switch penalty by the same CV. F1: one event "
         "per repetition, extra events false; '+-': an event "
         "within the latency before or after the action point, 'after only': at or after it."
     )

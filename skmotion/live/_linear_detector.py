@@ -85,12 +85,17 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         The fewest frames between two events.
     trigger : {"fall", "peak", "rise"}, default="fall"
         As for :class:`GestureDetector`.
-    jitter : int, default=1
-        Positive windows also end this many frames before and after each action point.
+    jitter : int or (int, int), default=1
+        Positive windows also end up to this many frames before and after each
+        action point; a pair ``(before, after)`` gives the two sides apart:
+        ``(0, 2)`` teaches a score that rises as the motion completes, not
+        before (a window ending before the action point holds an unfinished
+        motion, and may be drawn as a negative).
     n_negatives : int, default=40
         Windows ending away from action points drawn per training take.
     negative_gap : int, default=3
-        A negative window ends more than this many frames from every action point.
+        A negative window ends more than this many frames from every positive
+        window's end.
     none_label : str, default="none"
         The rejection class.
     random_state : int, RandomState instance or None, default=None
@@ -145,7 +150,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         "threshold": [Interval(Real, 0, 1, closed="both")],
         "refractory": [Interval(Integral, 0, None, closed="left")],
         "trigger": [StrOptions(set(TRIGGERS))],
-        "jitter": [Interval(Integral, 0, None, closed="left")],
+        "jitter": [Interval(Integral, 0, None, closed="left"), tuple, list],
         "n_negatives": [Interval(Integral, 0, None, closed="left")],
         "negative_gap": [Interval(Integral, 0, None, closed="left")],
         "none_label": [str],
@@ -209,6 +214,17 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
             )
         return tuple(joints)
 
+    def _jitter(self):
+        """``(before, after)``: the frames around an action point at which positive windows end."""
+        jitter = self.jitter
+        pair = (jitter, jitter) if isinstance(jitter, Integral) else tuple(jitter)
+        if len(pair) != 2 or not all(isinstance(j, Integral) and j >= 0 for j in pair):
+            raise ValueError(
+                "jitter: a number of frames >= 0 or a pair (before, after) of them, "
+                f"got {jitter!r}."
+            )
+        return pair
+
     def _features(self, take):
         return frame_features(np.ascontiguousarray(take, dtype=float), *self._joints())
 
@@ -235,7 +251,8 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         clips, points, labels = training_takes(self, X, y, action_points)
         self._joints()
         # each positive window also ends up to `jitter` frames from its action point
-        shifts = np.arange(-self.jitter, self.jitter + 1)
+        before, after = self._jitter()
+        shifts = np.arange(-before, after + 1)
         moved = [np.clip(p[:, None] + shifts, 0, len(c) - 1).ravel() for p, c in zip(points, clips)]
         moved_labels = [np.repeat(n, len(shifts)) for n in labels]
         rng = np.random.default_rng(check_random_state(self.random_state).randint(2**31))
@@ -246,7 +263,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
             window=self.window,
             none_label=self.none_label,
             n_negatives=self.n_negatives,
-            gap=self.negative_gap + self.jitter,
+            gap=self.negative_gap,
             rng=rng,
         )
         if len(set(np.concatenate(targets)) - {self.none_label}) == 0:

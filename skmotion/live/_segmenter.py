@@ -85,7 +85,10 @@ class ActivitySegmenter(ClipEstimatorMixin, BaseEstimator):
     recognizer : classifier, default=None
         A clip classifier with ``predict_proba`` or ``decision_function``,
         cloned and trained by :meth:`fit`. None:
-        ``make_pipeline(MotionTreeEncoder(), LogisticRegression())``.
+        ``make_pipeline(MotionTreeEncoder(), LogisticRegression())``. Several
+        recognisers averaged: scikit-learn's ``VotingClassifier(...,
+        voting="soft")`` (a frame's probabilities are then the mean of each
+        recogniser's).
     window : int, default=30
         Frames per window.
     step : int, default=5

@@ -152,6 +152,44 @@ def test_bad_input_is_named(fitted, skeleton_takes):
         LinearGestureDetector(root=5).fit(takes[:2], labels[:2], action_points=points[:2])
     with pytest.raises(ValueError, match="rejection class 'a'"):
         LinearGestureDetector(none_label="a").fit(takes[:2], labels[:2], action_points=points[:2])
+    with pytest.raises(ValueError, match=r"jitter: .* got \(1, 2, 3\)"):
+        LinearGestureDetector(jitter=(1, 2, 3)).fit(takes[:2], labels[:2], action_points=points[:2])
+
+
+@pytest.mark.parametrize(("jitter", "shifts"), [(1, [-1, 0, 1]), ((0, 2), [0, 1, 2])])
+def test_jitter_places_the_positive_windows_and_keeps_negatives_away(
+    skeleton_takes, monkeypatch, jitter, shifts
+):
+    """The positives end at each action point plus the shifts (by hand); every negative
+    ends more than negative_gap frames from all of them."""
+    from skmotion.live import _linear_detector
+
+    takes, points, labels = skeleton_takes
+    seen = {}
+
+    def spy(takes, moved, moved_labels, **kwargs):
+        seen["moved"], seen["gap"] = moved, kwargs["gap"]
+        seen["out"] = _linear_detector.training_ends.__wrapped__(
+            takes, moved, moved_labels, **kwargs
+        )
+        return seen["out"]
+
+    spy.__wrapped__ = _linear_detector.training_ends
+    monkeypatch.setattr(_linear_detector, "training_ends", spy)
+    detector = LinearGestureDetector(
+        n_segments=4, segment=3, jitter=jitter, negative_gap=1, n_negatives=1000, random_state=0
+    )
+    detector.fit(takes[:2], labels[:2], action_points=points[:2])
+    for take, p, moved, ends, y in zip(takes, points, seen["moved"], *seen["out"]):
+        expected = sorted(a + s for a in p for s in shifts if 0 <= a + s < len(take))
+        assert sorted(moved) == expected
+        negatives = ends[y == "none"]
+        assert len(negatives) and seen["gap"] == 1
+        assert np.abs(negatives[:, None] - np.array(expected)[None, :]).min() > 1
+        # every eligible end is drawn (n_negatives exceeds them): two frames before an action
+        # point is a negative when the positives start at the point, not when they start before
+        before = {a - 2 for a in p if a - 2 >= detector.window - 1}
+        assert before <= set(negatives) if jitter == (0, 2) else not before & set(negatives)
 
 
 @parametrize_with_clip_checks(

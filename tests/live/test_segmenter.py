@@ -46,6 +46,33 @@ def test_per_frame_labels_in_training_and_the_rejection_threshold(rng):
     assert set(model.predict_frames([test])[0]) == {"rest"}
 
 
+def test_a_soft_vote_of_recognisers_labels_with_their_mean_frame_probabilities(rng):
+    """Two recognisers averaged by sklearn's soft VotingClassifier (the labelling study's
+    choice on MSRC-12): each frame's probabilities are the mean of the two segmenters'
+    (a frame's probabilities are a mean of window probabilities, linear in them)."""
+    from sklearn.ensemble import VotingClassifier
+    from sklearn.linear_model import LogisticRegression
+    from sklearn.pipeline import make_pipeline
+
+    from skmotion.preprocessing import FlattenClips, ResampleClips
+
+    members = [
+        ("flat", make_pipeline(FlattenClips(), LogisticRegression(C=0.1))),
+        ("coarse", make_pipeline(ResampleClips(n_frames=3), FlattenClips(), LogisticRegression())),
+    ]
+    low, high = rng.normal(0, 0.5, (300, 2)), rng.normal(0.5, 0.5, (300, 2))
+    X, y = [low[:200], high[:200]], ["low", "high"]
+    test = [np.concatenate([low[200:], high[200:], low[250:]])]
+    vote = VotingClassifier(members, voting="soft")
+    got = ActivitySegmenter(vote, window=12, step=3).fit(X, y).predict_proba_frames(test)[0]
+    alone = [
+        ActivitySegmenter(m, window=12, step=3).fit(X, y).predict_proba_frames(test)[0]
+        for _, m in members
+    ]
+    np.testing.assert_allclose(got, (alone[0] + alone[1]) / 2)
+    assert not np.allclose(alone[0], alone[1])  # the members differ: the mean is a real mix
+
+
 @pytest.mark.parametrize("n_frames, window, step", [(50, 10, 3), (50, 10, 1), (12, 5, 20)])
 def test_covering_mean_is_the_mean_of_the_windows_over_each_frame(n_frames, window, step, rng):
     ends = np.arange(window - 1, n_frames, step)
