@@ -18,10 +18,12 @@ Two recurrences that numpy cannot vectorise, each one pass over a take:
 
 import numpy as np
 
-from libc.math cimport sqrt
+from libc.math cimport INFINITY, sqrt
 
 # Windows between two exact recomputations of a channel's mean and spread.
 DEF _EXACT_EVERY = 256
+# Stands in for a spread of 0 where the result is not used.
+DEF _TINY = 1e-300
 
 
 cdef inline void _exact(const double[::1] x, Py_ssize_t i, Py_ssize_t m,
@@ -61,10 +63,14 @@ def add_znorm_distance(
         Accumulates the distances, in place.
     """
     cdef Py_ssize_t n = x.shape[0], w = n - m + 1
-    cdef Py_ssize_t i, run = 1, stop
-    cdef double mu = 0.0, m2 = 0.0, new_mu, x_in, x_out, squared, root_m = sqrt(m)
+    cdef Py_ssize_t i, k, run = 1, stop
+    cdef double mu = 0.0, m2 = 0.0, new_mu, x_in, x_out, squared, spread, varies, root_m = sqrt(m)
     # Multiplications, not divisions, on the chain that carries the mean from frame to frame.
     cdef double inv_m = 1.0 / m
+    # The spreads (m2) of a stretch of windows; -inf marks a constant window.
+    cdef double m2s[_EXACT_EVERY]
+    cdef double* out
+    cdef const double* dot
     if dots.shape[0] != w or total.shape[0] != w:
         raise ValueError(f"dots and total need {w} values")
     with nogil:
@@ -75,27 +81,37 @@ def add_znorm_distance(
         while i < w:
             stop = min(i + _EXACT_EVERY, w)
             _exact(x, i, m, &mu, &m2)
-            while True:
-                run = run + 1 if x[i + m - 1] == x[i + m - 2] else 1
-                if run >= m:
-                    # A constant window: its spread is exactly 0.
-                    total[i] += 0.0 if query_constant else root_m
-                elif query_constant:
-                    total[i] += root_m
-                elif m2 > 0.0:
-                    # 2 m (1 - rho), rho = dots / (m std) and m std = sqrt(m m2).
-                    squared = 2.0 * (m - dots[i] * root_m / sqrt(m2))
-                    total[i] += sqrt(squared) if squared > 0.0 else 0.0
-                else:
-                    total[i] += root_m
-                i += 1
-                if i >= stop:
-                    break
-                x_in = x[i + m - 1]
-                x_out = x[i - 1]
-                new_mu = mu + (x_in - x_out) * inv_m
-                m2 = m2 + (x_in - x_out) * (x_in - new_mu + x_out - mu)
-                mu = new_mu
+            # The serial part: each window's spread from the previous one's.
+            for k in range(i, stop):
+                if k > i:
+                    x_in = x[k + m - 1]
+                    x_out = x[k - 1]
+                    new_mu = mu + (x_in - x_out) * inv_m
+                    m2 = m2 + (x_in - x_out) * (x_in - new_mu + x_out - mu)
+                    mu = new_mu
+                run = run + 1 if x[k + m - 1] == x[k + m - 2] else 1
+                # A constant window: its spread is exactly 0, whatever m2 rounded to.
+                m2s[k - i] = -INFINITY if run >= m else m2
+            out = &total[i]
+            dot = &dots[i]
+            if query_constant:
+                for k in range(stop - i):
+                    out[k] += 0.0 if m2s[k] == -INFINITY else root_m
+            else:
+                # Independent windows, no branch the compiler cannot turn into a
+                # select: this loop is vectorised. 2 m (1 - rho), rho = dots / (m std)
+                # and m std = sqrt(m m2); a spread that is 0 (or rounded below) is
+                # sqrt(m) from the query.
+                for k in range(stop - i):
+                    varies = m2s[k] > 0.0
+                    spread = m2s[k] if m2s[k] > _TINY else _TINY
+                    # At most 4 m (rho >= -1): the clamps only undo rounding, and keep
+                    # the product by 0 below finite.
+                    squared = 2.0 * (m - dot[k] * root_m / sqrt(spread))
+                    squared = squared if squared > 0.0 else 0.0
+                    squared = squared if squared < 4.0 * m else 4.0 * m
+                    out[k] += varies * sqrt(squared) + (1.0 - varies) * root_m
+            i = stop
     return total
 
 

@@ -39,6 +39,12 @@ __all__ = ["find_occurrences"]
 #: (the block less the query) wastes little, short enough to stay in cache.
 MIN_BLOCK = 2048
 
+#: FFT blocks per unit of work of the z-normalised search: every channel of
+#: that stretch of the take goes through the FFTs and the compiled pass while
+#: it is still in cache (a few hundred kilobytes), instead of one whole-take
+#: array per stage.
+CHUNK_BLOCKS = 16
+
 
 def _as_frames(values, what):
     """A float64 C-contiguous ``(n_frames, n_channels)`` array; NaN or inf is an error."""
@@ -54,13 +60,19 @@ def _as_frames(values, what):
     return np.ascontiguousarray(array)
 
 
+def _block_length(m):
+    """The FFT length for a query of ``m`` frames: a power of two, at least ``2 m``."""
+    return 1 << int(np.ceil(np.log2(max(MIN_BLOCK, 32 * m))))
+
+
 def sliding_dots(query, series, block=None, workers=None):
-    """``out[i] = sum_j query[j] * series[i + j]`` for every window, by block FFTs.
+    """``out[..., i] = sum_j query[..., j] * series[..., i + j]`` for every window, by block FFTs.
 
     Parameters
     ----------
-    query : ndarray of shape (m,)
-    series : ndarray of shape (n,), ``n >= m``
+    query : ndarray of shape (..., m)
+    series : ndarray of shape (..., n), ``n >= m``
+        Its leading dimensions are the query's (one query per series).
     block : int, default=None
         FFT length (a power of two at least ``2 m``); by default
         ``max(MIN_BLOCK, 32 m)`` rounded up to a power of two.
@@ -69,53 +81,63 @@ def sliding_dots(query, series, block=None, workers=None):
 
     Returns
     -------
-    dots : ndarray of shape (n - m + 1,)
+    dots : ndarray of shape (..., n - m + 1)
     """
-    m, n = len(query), len(series)
-    if block is None:
-        block = 1 << int(np.ceil(np.log2(max(MIN_BLOCK, 32 * m))))
+    m, n = query.shape[-1], series.shape[-1]
+    block = _block_length(m) if block is None else block
     hop = block - m + 1
     n_windows = n - m + 1
     n_blocks = -(-n_windows // hop)
-    padded = np.zeros(n_blocks * hop + m - 1)
-    padded[:n] = series
+    lead = series.shape[:-1]
+    padded = np.zeros((*lead, n_blocks * hop + m - 1))
+    padded[..., :n] = series
     # Block b holds frames b * hop ... b * hop + block - 1; its first hop
     # circular correlations do not wrap around.
-    blocks = as_strided(padded, (n_blocks, block), (hop * 8, 8), writeable=False)
-    spectrum = fft.rfft(blocks, axis=1, workers=workers)
-    spectrum *= np.conj(fft.rfft(query, block))
-    dots = fft.irfft(spectrum, block, axis=1, workers=workers)[:, :hop]
-    return dots.reshape(-1)[:n_windows]
+    blocks = as_strided(
+        padded, (*lead, n_blocks, block), (*padded.strides[:-1], hop * 8, 8), writeable=False
+    )
+    spectrum = fft.rfft(blocks, axis=-1, workers=workers)
+    spectrum *= np.conj(fft.rfft(query, block, axis=-1))[..., None, :]
+    dots = fft.irfft(spectrum, block, axis=-1, workers=workers)[..., :hop]
+    return dots.reshape(*lead, -1)[..., :n_windows]
 
 
 def _znorm_profile(query, take, n_threads):
     """Mean over channels of the z-normalised distance of each window to the query.
 
-    With several threads, each handles whole channels: the FFTs and the
-    compiled pass release the GIL, and a channel's work is independent.
+    The take is searched a stretch of ``CHUNK_BLOCKS`` FFT blocks at a time,
+    every channel at once; with several threads, each takes whole stretches
+    (the FFTs and the compiled pass release the GIL, and each stretch writes
+    its own windows of the result).
     """
     m, n_channels = query.shape
-    # Channel-major, each channel shifted to mean 0 in one pass: shifting changes
-    # no z-normalised distance but shrinks the FFT's rounding, which grows with the
-    # values' size; a contiguous channel is what the FFT and the compiled pass read.
-    channels = np.ascontiguousarray(take.T)
-    channels -= channels.mean(axis=1, keepdims=True)
+    n_windows = len(take) - m + 1
+    constant = (query == query[:1]).all(axis=0)
+    # A constant query channel is never correlated (the compiled pass ignores its dots).
+    q_hat = (query - query.mean(axis=0)) / np.where(constant, 1.0, query.std(axis=0))
+    q_hat = np.ascontiguousarray(q_hat.T)
+    span = (_block_length(m) - m + 1) * CHUNK_BLOCKS
+    total = np.zeros(n_windows)
 
-    def add_channels(which):
-        total = np.zeros(len(take) - m + 1)
-        for c in which:
-            q = query[:, c]
-            constant = bool(np.all(q == q[0]))
-            dots = total if constant else sliding_dots((q - q.mean()) / q.std(), channels[c])
-            _loops.add_znorm_distance(channels[c], dots, m, constant, total)
-        return total
+    def add_stretch(first):
+        last = min(first + span, n_windows)
+        frames = take[first : last + m - 1]
+        # Channel-major, each channel shifted to mean 0: shifting changes no
+        # z-normalised distance (nor a dot product with a query of mean 0) but
+        # shrinks the FFT's rounding, which grows with the values' size.
+        channels = np.subtract(frames.T, frames.mean(axis=0)[:, None], order="C")
+        dots = sliding_dots(q_hat, channels)
+        for c in range(n_channels):
+            _loops.add_znorm_distance(channels[c], dots[c], m, bool(constant[c]), total[first:last])
 
-    n_threads = min(n_threads, n_channels)
-    if n_threads <= 1:
-        return add_channels(range(n_channels)) / n_channels
-    with ThreadPoolExecutor(n_threads) as pool:
-        parts = list(pool.map(add_channels, np.array_split(np.arange(n_channels), n_threads)))
-    return sum(parts) / n_channels
+    stretches = range(0, n_windows, span)
+    if min(n_threads, len(stretches)) <= 1:
+        for first in stretches:
+            add_stretch(first)
+    else:
+        with ThreadPoolExecutor(min(n_threads, len(stretches))) as pool:
+            list(pool.map(add_stretch, stretches))
+    return total / n_channels
 
 
 def _dtw_profile(query, take):
@@ -199,8 +221,8 @@ def find_occurrences(
     max_distance : float, default=inf
         Occurrences farther than this are not returned.
     n_jobs : int, default=None
-        Threads (``"znorm"``), each handling whole channels; None is one, -1
-        all cores.
+        Threads (``"znorm"``), each handling whole stretches of a take; None
+        is one, -1 all cores.
 
     Returns
     -------
@@ -262,6 +284,30 @@ def find_occurrences(
         start = int(starts[t][local])
         end = start + m if metric == "znorm" else local + 1
         rows.append((t, start, end, float(profiles[t][local])))
-    return pd.DataFrame(rows, columns=["take", "start", "end", "distance"]).astype(
+    found = pd.DataFrame(rows, columns=["take", "start", "end", "distance"]).astype(
         {"take": np.intp, "start": np.intp, "end": np.intp, "distance": float}
     )
+    if metric == "znorm" and len(found):
+        windows = np.stack([arrays[t][s : s + m] for t, s in zip(found["take"], found.start)])
+        found["distance"] = _window_distances(query, windows)
+    return found
+
+
+def _window_distances(query, windows):
+    """The z-normalised distance of each window, each window z-normalised explicitly.
+
+    What is reported for the chosen occurrences: the FFT's dot products round
+    to about ``1e-16`` of the values' size, which the square root of a distance
+    near 0 turns into ``1e-8``-``1e-7``; here an exact match is at 0 (to
+    ``1e-15``). ``windows`` is ``(k, m, n_channels)``.
+    """
+    m = query.shape[0]
+    q_constant = (query == query[:1]).all(axis=0)
+    w_constant = (windows == windows[:, :1]).all(axis=1)
+    q_hat = (query - query.mean(axis=0)) / np.where(q_constant, 1.0, query.std(axis=0))
+    spread = np.where(w_constant, 1.0, windows.std(axis=1))
+    w_hat = (windows - windows.mean(axis=1, keepdims=True)) / spread[:, None]
+    per_channel = np.sqrt(((w_hat - q_hat) ** 2).sum(axis=1))
+    per_channel = np.where(w_constant & q_constant, 0.0, per_channel)
+    per_channel = np.where(w_constant ^ q_constant, np.sqrt(m), per_channel)
+    return per_channel.mean(axis=1)
