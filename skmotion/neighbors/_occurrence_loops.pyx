@@ -42,8 +42,8 @@ cdef inline void _exact(const double[::1] x, Py_ssize_t i, Py_ssize_t m,
 
 
 def add_znorm_distance(
-    const double[::1] x, const double[::1] dots, Py_ssize_t m, bint query_constant,
-    double[::1] total,
+    const double[::1] x, const double[:, ::1] dots, Py_ssize_t hop, Py_ssize_t m,
+    bint query_constant, double[::1] total,
 ):
     """Add one channel's z-normalised distance of every window to the query into ``total``.
 
@@ -51,9 +51,13 @@ def add_znorm_distance(
     ----------
     x : ndarray of shape (n,)
         The channel of the take.
-    dots : ndarray of shape (n - m + 1,)
+    dots : ndarray of shape (n_blocks, block)
+        The FFT blocks' correlations: ``dots[i // hop, i % hop]`` is
         ``sum_j q_hat[j] x[i + j]`` with ``q_hat`` the z-normalised query
-        channel (ignored when the query channel is constant).
+        channel (ignored when the query channel is constant); read as they
+        come out of the inverse FFT, without gathering them first.
+    hop : int
+        Windows per block, ``n_blocks * hop >= n - m + 1``.
     m : int
         The query's length, ``2 <= m <= n``.
     query_constant : bool
@@ -71,7 +75,7 @@ def add_znorm_distance(
     cdef double m2s[_EXACT_EVERY]
     cdef double* out
     cdef const double* dot
-    if dots.shape[0] != w or total.shape[0] != w:
+    if dots.shape[0] * hop < w or dots.shape[1] < hop or total.shape[0] != w:
         raise ValueError(f"dots and total need {w} values")
     with nogil:
         # The run of equal values ending at frame m - 2, before the first window's last frame.
@@ -79,7 +83,8 @@ def add_znorm_distance(
             run = run + 1 if x[i] == x[i - 1] else 1
         i = 0
         while i < w:
-            stop = min(i + _EXACT_EVERY, w)
+            # A stretch never crosses a block of the dots.
+            stop = min(i + _EXACT_EVERY, w, (i // hop + 1) * hop)
             _exact(x, i, m, &mu, &m2)
             # The serial part: each window's spread from the previous one's.
             for k in range(i, stop):
@@ -93,7 +98,7 @@ def add_znorm_distance(
                 # A constant window: its spread is exactly 0, whatever m2 rounded to.
                 m2s[k - i] = -INFINITY if run >= m else m2
             out = &total[i]
-            dot = &dots[i]
+            dot = &dots[i // hop, i % hop]
             if query_constant:
                 for k in range(stop - i):
                     out[k] += 0.0 if m2s[k] == -INFINITY else root_m
