@@ -9,7 +9,9 @@ Two recurrences that numpy cannot vectorise, each one pass over a take:
   windows so rounding cannot drift; a window is constant exactly when the run
   of equal values ending at its last frame is ``m`` long (no tolerance to
   choose). One pass per channel, adding into the total, where numpy needed
-  five arrays and as many passes;
+  five arrays and as many passes; per stretch of ``_EXACT_EVERY`` windows,
+  the spreads first (the serial part), then the distances in a loop without
+  branches, which the compiler vectorises (setup.py's flags);
 - subsequence dynamic time warping (Mueller, "Information Retrieval for Music
   and Motion", 2007, section 4.4): the query must be matched whole, the take
   may start and end anywhere. One column of the cost matrix per take frame;

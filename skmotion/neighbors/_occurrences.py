@@ -6,10 +6,12 @@ Two distances between the query and a stretch of a take:
   query's length (Mueen et al., MASS, 2017), per channel, averaged over the
   channels, as stumpy's ``match`` defines it for several dimensions. The
   sliding dot products are FFT correlations computed block by block
-  (overlap-save: many short transforms instead of one of the take's length,
-  which keeps the work in cache); the windows' means and spreads come from a
-  compiled sliding pass (``_occurrence_loops.pyx``) that is exact for
-  constant windows;
+  (overlap-save: many short transforms instead of one of the take's length);
+  the take is searched a stretch of blocks at a time, every channel at once,
+  so that the copy, the FFTs and the distances work in cache; the windows'
+  means and spreads come from a compiled sliding pass
+  (``_occurrence_loops.pyx``) that is exact for constant windows. The chosen
+  occurrences' distances are recomputed by z-normalising their windows;
 - ``"dtw"``: subsequence dynamic time warping (Mueller 2007): the whole query
   is warped onto a stretch of the take that may start and end anywhere, with
   the squared Euclidean cost between frames; the distance is the square root
