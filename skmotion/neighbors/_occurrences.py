@@ -140,7 +140,9 @@ def _znorm_profile(query, take, n_threads):
     q_hat = (query - query.mean(axis=0)) / np.where(constant, 1.0, query.std(axis=0))
     q_spectrum = np.conj(np.fft.rfft(q_hat.T, block, axis=-1))[:, None, :]
     hop = block - m + 1
-    span = hop * CHUNK_BLOCKS
+    # A short take is one stretch of only the blocks it fills.
+    per_stretch = min(CHUNK_BLOCKS, -(-n_windows // hop))
+    span = hop * per_stretch
     total = np.zeros(n_windows)
     stretches = range(0, n_windows, span)
     n_threads = max(1, min(n_threads, len(stretches)))
@@ -148,20 +150,28 @@ def _znorm_profile(query, take, n_threads):
     def add_stretches(thread):
         # This thread's buffers, reused for each of its stretches.
         padded = np.empty((n_channels, span + m - 1))
-        spectrum = np.empty((n_channels, CHUNK_BLOCKS, block // 2 + 1), dtype=complex)
-        dots = np.empty((n_channels, CHUNK_BLOCKS, block))
+        spectrum = np.empty((n_channels, per_stretch, block // 2 + 1), dtype=complex)
+        dots = np.empty((n_channels, per_stretch, block))
         for first in stretches[thread::n_threads]:
             last = min(first + span, n_windows)
             frames = take[first : last + m - 1]
+            n_blocks = -(-(last - first) // hop)
             # Channel-major, each channel shifted to mean 0: shifting changes no
             # z-normalised distance (nor a dot product with a query of mean 0) but
             # shrinks the FFT's rounding, which grows with the values' size.
             np.subtract(frames.T, frames.mean(axis=0)[:, None], out=padded[:, : len(frames)])
             padded[:, len(frames) :] = 0.0
-            _block_dots(q_spectrum, padded, hop, block, spectrum, dots)
+            found = _block_dots(
+                q_spectrum,
+                padded[:, : n_blocks * hop + m - 1],
+                hop,
+                block,
+                spectrum[:, :n_blocks],
+                dots[:, :n_blocks],
+            )
             for c in range(n_channels):
                 _loops.add_znorm_distance(
-                    padded[c, : len(frames)], dots[c], hop, m, bool(constant[c]), total[first:last]
+                    padded[c, : len(frames)], found[c], hop, m, bool(constant[c]), total[first:last]
                 )
 
     if n_threads == 1:
