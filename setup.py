@@ -71,7 +71,9 @@ psi_rank = Extension(
 occurrence_loops = Extension(
     "skmotion.neighbors._occurrence_loops",
     ["skmotion/neighbors/_occurrence_loops.pyx"],
-    extra_compile_args=["-O3"],
+    # No errno from sqrt and no trapping comparisons: the distance loop's selects are then
+    # branch-free and the loop is vectorised.
+    extra_compile_args=["-O3", "-fno-math-errno", "-fno-trapping-math"],
 )
 # Weighted sums of rows per group, in row order (utils/_group_sums, the tree encoder's
 # per-clip sums); no contraction, so each product is rounded before it is added, as SciPy's

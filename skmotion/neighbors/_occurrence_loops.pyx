@@ -9,7 +9,9 @@ Two recurrences that numpy cannot vectorise, each one pass over a take:
   windows so rounding cannot drift; a window is constant exactly when the run
   of equal values ending at its last frame is ``m`` long (no tolerance to
   choose). One pass per channel, adding into the total, where numpy needed
-  five arrays and as many passes;
+  five arrays and as many passes; per stretch of ``_EXACT_EVERY`` windows,
+  the spreads first (the serial part), then the distances in a loop without
+  branches, which the compiler vectorises (setup.py's flags);
 - subsequence dynamic time warping (Mueller, "Information Retrieval for Music
   and Motion", 2007, section 4.4): the query must be matched whole, the take
   may start and end anywhere. One column of the cost matrix per take frame;
@@ -18,10 +20,12 @@ Two recurrences that numpy cannot vectorise, each one pass over a take:
 
 import numpy as np
 
-from libc.math cimport sqrt
+from libc.math cimport INFINITY, sqrt
 
 # Windows between two exact recomputations of a channel's mean and spread.
 DEF _EXACT_EVERY = 256
+# Stands in for a spread of 0 where the result is not used.
+DEF _TINY = 1e-300
 
 
 cdef inline void _exact(const double[::1] x, Py_ssize_t i, Py_ssize_t m,
@@ -40,8 +44,8 @@ cdef inline void _exact(const double[::1] x, Py_ssize_t i, Py_ssize_t m,
 
 
 def add_znorm_distance(
-    const double[::1] x, const double[::1] dots, Py_ssize_t m, bint query_constant,
-    double[::1] total,
+    const double[::1] x, const double[:, ::1] dots, Py_ssize_t hop, Py_ssize_t m,
+    bint query_constant, double[::1] total,
 ):
     """Add one channel's z-normalised distance of every window to the query into ``total``.
 
@@ -49,9 +53,13 @@ def add_znorm_distance(
     ----------
     x : ndarray of shape (n,)
         The channel of the take.
-    dots : ndarray of shape (n - m + 1,)
+    dots : ndarray of shape (n_blocks, block)
+        The FFT blocks' correlations: ``dots[i // hop, i % hop]`` is
         ``sum_j q_hat[j] x[i + j]`` with ``q_hat`` the z-normalised query
-        channel (ignored when the query channel is constant).
+        channel (ignored when the query channel is constant); read as they
+        come out of the inverse FFT, without gathering them first.
+    hop : int
+        Windows per block, ``n_blocks * hop >= n - m + 1``.
     m : int
         The query's length, ``2 <= m <= n``.
     query_constant : bool
@@ -61,11 +69,15 @@ def add_znorm_distance(
         Accumulates the distances, in place.
     """
     cdef Py_ssize_t n = x.shape[0], w = n - m + 1
-    cdef Py_ssize_t i, run = 1, stop
-    cdef double mu = 0.0, m2 = 0.0, new_mu, x_in, x_out, squared, root_m = sqrt(m)
+    cdef Py_ssize_t i, k, run = 1, stop
+    cdef double mu = 0.0, m2 = 0.0, new_mu, x_in, x_out, squared, spread, varies, root_m = sqrt(m)
     # Multiplications, not divisions, on the chain that carries the mean from frame to frame.
     cdef double inv_m = 1.0 / m
-    if dots.shape[0] != w or total.shape[0] != w:
+    # The spreads (m2) of a stretch of windows; -inf marks a constant window.
+    cdef double m2s[_EXACT_EVERY]
+    cdef double* out
+    cdef const double* dot
+    if dots.shape[0] * hop < w or dots.shape[1] < hop or total.shape[0] != w:
         raise ValueError(f"dots and total need {w} values")
     with nogil:
         # The run of equal values ending at frame m - 2, before the first window's last frame.
@@ -73,29 +85,40 @@ def add_znorm_distance(
             run = run + 1 if x[i] == x[i - 1] else 1
         i = 0
         while i < w:
-            stop = min(i + _EXACT_EVERY, w)
+            # A stretch never crosses a block of the dots.
+            stop = min(i + _EXACT_EVERY, w, (i // hop + 1) * hop)
             _exact(x, i, m, &mu, &m2)
-            while True:
-                run = run + 1 if x[i + m - 1] == x[i + m - 2] else 1
-                if run >= m:
-                    # A constant window: its spread is exactly 0.
-                    total[i] += 0.0 if query_constant else root_m
-                elif query_constant:
-                    total[i] += root_m
-                elif m2 > 0.0:
-                    # 2 m (1 - rho), rho = dots / (m std) and m std = sqrt(m m2).
-                    squared = 2.0 * (m - dots[i] * root_m / sqrt(m2))
-                    total[i] += sqrt(squared) if squared > 0.0 else 0.0
-                else:
-                    total[i] += root_m
-                i += 1
-                if i >= stop:
-                    break
-                x_in = x[i + m - 1]
-                x_out = x[i - 1]
-                new_mu = mu + (x_in - x_out) * inv_m
-                m2 = m2 + (x_in - x_out) * (x_in - new_mu + x_out - mu)
-                mu = new_mu
+            # The serial part: each window's spread from the previous one's.
+            for k in range(i, stop):
+                if k > i:
+                    x_in = x[k + m - 1]
+                    x_out = x[k - 1]
+                    new_mu = mu + (x_in - x_out) * inv_m
+                    m2 = m2 + (x_in - x_out) * (x_in - new_mu + x_out - mu)
+                    mu = new_mu
+                run = run + 1 if x[k + m - 1] == x[k + m - 2] else 1
+                # A constant window: its spread is exactly 0, whatever m2 rounded to.
+                m2s[k - i] = -INFINITY if run >= m else m2
+            out = &total[i]
+            dot = &dots[i // hop, i % hop]
+            if query_constant:
+                for k in range(stop - i):
+                    out[k] += 0.0 if m2s[k] == -INFINITY else root_m
+            else:
+                # Independent windows, no branch the compiler cannot turn into a
+                # select: this loop is vectorised. 2 m (1 - rho), rho = dots / (m std)
+                # and m std = sqrt(m m2); a spread that is 0 (or rounded below) is
+                # sqrt(m) from the query.
+                for k in range(stop - i):
+                    varies = m2s[k] > 0.0
+                    spread = m2s[k] if m2s[k] > _TINY else _TINY
+                    # At most 4 m (rho >= -1): the clamps only undo rounding, and keep
+                    # the product by 0 below finite.
+                    squared = 2.0 * (m - dot[k] * root_m / sqrt(spread))
+                    squared = squared if squared > 0.0 else 0.0
+                    squared = squared if squared < 4.0 * m else 4.0 * m
+                    out[k] += varies * sqrt(squared) + (1.0 - varies) * root_m
+            i = stop
     return total
 
 

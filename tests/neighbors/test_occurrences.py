@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from skmotion.neighbors import find_occurrences
+from skmotion.neighbors import _occurrences, find_occurrences
 from skmotion.neighbors._occurrences import sliding_dots
 
 
@@ -116,6 +116,10 @@ def test_sliding_dots_is_the_direct_product(block, rng):
     q, x = rng.normal(size=37), rng.normal(size=3001)
     direct = np.lib.stride_tricks.sliding_window_view(x, 37) @ q
     np.testing.assert_allclose(sliding_dots(q, x, block), direct, atol=1e-10)
+    # Several channels at once, one query each.
+    qs, xs = rng.normal(size=(3, 37)), rng.normal(size=(3, 3001))
+    many = np.stack([np.lib.stride_tricks.sliding_window_view(x, 37) @ q for q, x in zip(qs, xs)])
+    np.testing.assert_allclose(sliding_dots(qs, xs, block), many, atol=1e-10)
 
 
 def test_far_offset_and_scale_do_not_change_the_answer(rng):
@@ -146,11 +150,13 @@ def test_bad_input_is_named(rng):
         find_occurrences(take[:1], [take])
 
 
-def test_threads_split_the_channels_and_agree_with_one(rng):
-    # Five channels over two threads: 3 + 2, each thread summing its own; the
+def test_threads_split_the_take_and_agree_with_one(rng, monkeypatch):
+    # Stretches of one FFT block (2048 - 19 windows): the take's 4,081 windows are
+    # three stretches over two threads, each thread writing its own windows; the
     # reference is the explicit z-normalisation of every window.
-    take = np.cumsum(rng.normal(size=(400, 5)), axis=0)
-    query = take[150:170] + rng.normal(scale=0.05, size=(20, 5))
+    monkeypatch.setattr(_occurrences, "CHUNK_BLOCKS", 1)
+    take = np.cumsum(rng.normal(size=(4100, 3)), axis=0)
+    query = take[150:170] + rng.normal(scale=0.05, size=(20, 3))
     one = find_occurrences(query, [take], n_occurrences=4)
     two = find_occurrences(query, [take], n_occurrences=4, n_jobs=2)
     assert two.start.tolist() == one.start.tolist()
@@ -158,3 +164,7 @@ def test_threads_split_the_channels_and_agree_with_one(rng):
     profile = _znorm_reference(query, take)
     assert one.start[0] == int(np.argmin(profile)) == 150
     np.testing.assert_allclose(one.distance[0], profile.min(), atol=1e-9)
+    # Every window, across the stretches' seams, on one thread and on two.
+    for n_threads in (1, 2):
+        searched = _occurrences._znorm_profile(query, take, n_threads)
+        np.testing.assert_allclose(searched, profile, atol=1e-7)
