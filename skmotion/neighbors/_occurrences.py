@@ -188,31 +188,53 @@ def _dtw_profile(query, take):
     return np.sqrt(cost), start
 
 
+def _profiles(query, takes, metric, max_distance, n_threads):
+    """Each take's distance profile, and the start of each entry's window (None: its index).
+
+    An entry farther than ``max_distance`` is set to inf: never chosen, and never
+    excluding another.
+    """
+    m = len(query)
+    profiles, starts = [], []
+    for take in takes:
+        if metric == "znorm":
+            profile = _znorm_profile(query, take, n_threads) if len(take) >= m else np.empty(0)
+            start = None  # a window starts at its own index
+        else:
+            profile, start = _dtw_profile(query, take)
+        if max_distance < np.inf:
+            profile[~(profile <= max_distance)] = np.inf
+        profiles.append(profile)
+        starts.append(start)
+    return profiles, starts
+
+
 def _greedy(profiles, starts, n_occurrences, exclusion):
-    """Indices into the concatenated profiles, smallest first, each excluding its neighbours.
+    """``(index, distance)`` into the concatenated profiles, smallest first, each
+    excluding its neighbours; and the profiles' bounds.
 
     With ``exclusion`` (z-normalised windows), the indices within ``exclusion``
     of a chosen one in the same take; without (DTW), every path that overlaps
     the chosen one (those ending at or after its start and starting at or
-    before its end).
+    before its end). The profiles are the caller's own: excluded entries are set
+    to inf in them (one take's profile is not copied).
     """
     bounds = np.concatenate([[0], np.cumsum([len(p) for p in profiles])]).astype(np.intp)
-    distance = np.concatenate(profiles) if profiles else np.empty(0)
-    start = np.concatenate(starts) if starts else np.empty(0, dtype=np.intp)
+    distance = profiles[0] if len(profiles) == 1 else np.concatenate(profiles or [np.empty(0)])
     chosen = []
     limit = len(distance) if n_occurrences is None else n_occurrences
     while len(chosen) < limit and len(distance):
         i = int(np.argmin(distance))
         if not np.isfinite(distance[i]):
             break
-        chosen.append(i)
+        chosen.append((i, float(distance[i])))
         t = int(np.searchsorted(bounds, i, side="right")) - 1
         if exclusion is not None:
             distance[max(bounds[t], i - exclusion) : min(bounds[t + 1], i + exclusion + 1)] = np.inf
         else:
-            first = bounds[t] + start[i]
+            first = bounds[t] + starts[t][i - bounds[t]]
             later = distance[first : bounds[t + 1]]
-            later[start[first : bounds[t + 1]] <= i - bounds[t]] = np.inf
+            later[starts[t][first - bounds[t] :] <= i - bounds[t]] = np.inf
     return chosen, bounds
 
 
@@ -303,29 +325,19 @@ def find_occurrences(
         if array.shape[1] != n_channels:
             raise ValueError(f"take {i} has {array.shape[1]} channels and the query {n_channels}")
         arrays.append(array)
-    n_threads = effective_n_jobs(n_jobs)
     if metric == "znorm":
         exclusion = int(np.ceil(m / 4)) if exclusion is None else exclusion
     else:
         exclusion = None
-    profiles, starts = [], []
-    for take in arrays:
-        if metric == "znorm":
-            profile = _znorm_profile(query, take, n_threads) if len(take) >= m else np.empty(0)
-            start = np.arange(len(profile))
-        else:
-            profile, start = _dtw_profile(query, take)
-        # Farther than max_distance is never chosen (and never excludes another).
-        profiles.append(np.where(profile <= max_distance, profile, np.inf))
-        starts.append(start)
+    profiles, starts = _profiles(query, arrays, metric, max_distance, effective_n_jobs(n_jobs))
     chosen, bounds = _greedy(profiles, starts, n_occurrences, exclusion)
     rows = []
-    for index in chosen:
+    for index, distance in chosen:
         t = int(np.searchsorted(bounds, index, side="right")) - 1
         local = index - int(bounds[t])
-        start = int(starts[t][local])
+        start = local if starts[t] is None else int(starts[t][local])
         end = start + m if metric == "znorm" else local + 1
-        rows.append((t, start, end, float(profiles[t][local])))
+        rows.append((t, start, end, distance))
     found = pd.DataFrame(rows, columns=["take", "start", "end", "distance"]).astype(
         {"take": np.intp, "start": np.intp, "end": np.intp, "distance": float}
     )
