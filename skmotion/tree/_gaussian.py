@@ -101,17 +101,22 @@ def ledoit_wolf_shrinkage(scatter, sq_norms):
     return 1.0 if delta <= 0 else float(beta / delta)
 
 
-def estimate_covariance(scatter, sq_norms, kind, reg):
+def estimate_covariance(scatter, n, kind, reg, sq_norms=None):
     """The covariance of one node's frames, by the chosen estimator.
 
     Parameters
     ----------
-    scatter, sq_norms : ndarray
-        The node's centred moments (see :func:`centred_moments`).
+    scatter : ndarray of shape (n_channels, n_channels)
+        The node's scatter (see :func:`centred_moments`).
+    n : int
+        The node's number of frames.
     kind : {"diag", "full", "spherical"}
         The estimator (see the module's description).
     reg : float
         Added to every variance (the diagonal), so no covariance is singular.
+    sq_norms : ndarray of shape (n,), default=None
+        Each frame's squared centred norm (see :func:`centred_moments`); only
+        ``"full"`` (Ledoit-Wolf) needs them.
 
     Returns
     -------
@@ -123,15 +128,17 @@ def estimate_covariance(scatter, sq_norms, kind, reg):
     >>> import numpy as np
     >>> from skmotion.tree._gaussian import centred_moments, estimate_covariance
     >>> _, scatter, sq_norms = centred_moments(np.array([[0.0, 1.0], [2.0, 1.0]]))
-    >>> estimate_covariance(scatter, sq_norms, "diag", 0.5).tolist()
+    >>> estimate_covariance(scatter, 2, "diag", 0.5).tolist()
     [1.5, 0.5]
     """
-    n, d = len(sq_norms), len(scatter)
+    d = len(scatter)
     if kind == "diag":
         return np.diag(scatter) / n + reg
     if kind == "spherical":
         return float(np.trace(scatter) / (n * d) + reg)
     if kind == "full":
+        if sq_norms is None or len(sq_norms) != n:
+            raise ValueError("the 'full' estimate needs each of the n frames' squared norm.")
         scale, floor = _ledoit_wolf_parts(scatter, sq_norms, reg)
         covariance = scale * scatter
         covariance[np.diag_indices_from(covariance)] += floor
@@ -182,7 +189,7 @@ def low_rank_covariance(centred, scatter, sq_norms, reg):
     >>> floor, vectors, values = low_rank_covariance(frames - mean, scatter, sq_norms, 1e-3)
     >>> vectors.shape
     (3, 10)
-    >>> full = estimate_covariance(scatter, sq_norms, "full", 1e-3)
+    >>> full = estimate_covariance(scatter, len(sq_norms), "full", 1e-3, sq_norms)
     >>> np.allclose(floor * np.eye(10) + vectors.T @ np.diag(values) @ vectors, full)
     True
     """

@@ -30,7 +30,7 @@ def reference_stats(tree, frames):
             if tree.depth[node] != layer:
                 continue
             mean, scatter, sq = centred_moments(frames[ids == node])
-            cov = estimate_covariance(scatter, sq, tree.covariance_type, tree.reg)
+            cov = estimate_covariance(scatter, len(sq), tree.covariance_type, tree.reg, sq)
             out[int(node)] = (int((ids == node).sum()), mean, cov)
     return out
 
@@ -129,7 +129,9 @@ def test_moments_merge_exactly():
         mean, scatter, sq = centred_moments(np.concatenate(parts))
         np.testing.assert_allclose(merged.mean[0], mean, rtol=1e-12)
         np.testing.assert_allclose(
-            merged.covariances(0.01)[0], estimate_covariance(scatter, sq, kind, 0.01), rtol=1e-10
+            merged.covariances(0.01)[0],
+            estimate_covariance(scatter, len(sq), kind, 0.01, sq),
+            rtol=1e-10,
         )
         if kind == "full":
             np.testing.assert_allclose(merged.s4[0], sq @ sq, rtol=1e-10)

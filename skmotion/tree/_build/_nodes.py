@@ -206,14 +206,12 @@ class _Builder:
         may_split = may_split and n >= self.min_split
         root = nodes["parent"][node] < 0
         mean, scatter, sq_norms, raw = self.moments(node, block, may_split or root, sibling)
-        if sq_norms is None:  # the covariance estimators take the frame count from it
-            sq_norms = np.zeros(n)
         if self.reg is None:  # the root: reg_covar is relative to its mean per-channel variance
             scale = np.trace(scatter) / (n * d)
             self.reg = self.reg_covar * scale if scale > 0 else float(self.reg_covar)
         if root:
             self.root_scatter = scatter
-        result = {"mean": mean, "cov": estimate_covariance(scatter, sq_norms, self.kind, self.reg)}
+        result = {"mean": mean, "cov": estimate_covariance(scatter, n, self.kind, self.reg, sq_norms)}
         result["raw"] = raw
         if self.kind == "full" and n <= d:  # the covariance is low rank plus a floor
             result["low_rank"] = low_rank_covariance(block - mean, scatter, sq_norms, self.reg)

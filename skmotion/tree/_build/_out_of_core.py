@@ -400,9 +400,7 @@ def _stream_layer(dask, chunks, d, nodes, open_ids, closed, params, state, budge
     for nid in open_ids:
         n, mean, scatter = merged[nid]
         t["mean"][nid] = mean
-        t["cov"][nid] = estimate_covariance(
-            scatter, np.broadcast_to(0.0, n), params.covariance_type, state["reg"]
-        )
+        t["cov"][nid] = estimate_covariance(scatter, n, params.covariance_type, state["reg"])
         may_split = params.max_depth is None or t["depth"][nid] < params.max_depth
         axis = _principal_axis(None, scatter) if may_split and n >= min_split else None
         if axis is not None:

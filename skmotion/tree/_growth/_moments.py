@@ -200,7 +200,7 @@ def _shifted(m, u):
 
 
 def _ledoit_wolf(scatter, n, s4, reg):
-    """``estimate_covariance(scatter, sq_norms, "full", reg)`` from two sums of ``sq_norms``.
+    """``estimate_covariance(scatter, n, "full", reg, sq_norms)`` from two sums of ``sq_norms``.
 
     Those are ``sum |x - m|^2`` (the scatter's trace) and ``sum |x - m|^4``
     (``s4``); the arithmetic is that of :func:`ledoit_wolf_shrinkage`.
