@@ -30,6 +30,11 @@ def tree_modules(package, names, pxd):
     ]
 
 
+def module(name, *flags):
+    """The compiled module ``name`` (dotted) from its ``.pyx`` file, at -O3 and ``flags``."""
+    return Extension(name, [name.replace(".", "/") + ".pyx"], extra_compile_args=["-O3", *flags])
+
+
 # -fopenmp-simd honours the `omp simd` pragmas of _emission.h (vectorised sums) without
 # linking OpenMP. The compiled decoder (tree/_decoder/): the beam search itself (_beam), a
 # layer's candidates and emissions (_beam_candidates), its memory (_beam_memory) and the
@@ -48,81 +53,38 @@ online = tree_modules(
     ["_structs.pxd", "_answers.pxd", "_state.pxd", "_step.pxd"],
 )
 # The body frame of point trajectories, one pass over the frames (preprocessing/_position_frame).
-position_frame = Extension(
-    "skmotion.preprocessing._position_frame_loops",
-    ["skmotion/preprocessing/_position_frame_loops.pyx"],
-    extra_compile_args=["-O3"],
-)
+position_frame = module("skmotion.preprocessing._position_frame_loops")
 # Leading eigenpairs of each clip's Gram matrix (decomposition/_clip_svd.py): SciPy's
 # BLAS/LAPACK through the pointers SciPy exports, so no build-time SciPy.
-leading = Extension(
-    "skmotion.decomposition._leading",
-    ["skmotion/decomposition/_leading.pyx"],
-    extra_compile_args=["-O3"],
-)
+leading = module("skmotion.decomposition._leading")
 # psi distances of a leaf's queries to its candidates (neighbors/_ranking.py).
-psi_rank = Extension(
-    "skmotion.neighbors._psi_rank",
-    ["skmotion/neighbors/_psi_rank.pyx"],
-    extra_compile_args=["-O3"],
-)
+psi_rank = module("skmotion.neighbors._psi_rank")
 # Sliding window statistics and subsequence DTW of the occurrence search
-# (neighbors/_occurrences.py).
-occurrence_loops = Extension(
-    "skmotion.neighbors._occurrence_loops",
-    ["skmotion/neighbors/_occurrence_loops.pyx"],
-    # No errno from sqrt and no trapping comparisons: the distance loop's selects are then
-    # branch-free and the loop is vectorised.
-    extra_compile_args=["-O3", "-fno-math-errno", "-fno-trapping-math"],
+# (neighbors/_occurrences.py); no errno from sqrt and no trapping comparisons, so the
+# distance loop's selects are branch-free and the loop is vectorised.
+occurrence_loops = module(
+    "skmotion.neighbors._occurrence_loops", "-fno-math-errno", "-fno-trapping-math"
 )
 # Weighted sums of rows per group, in row order (utils/_group_sums, the tree encoder's
 # per-clip sums); no contraction, so each product is rounded before it is added, as SciPy's
 # sparse product rounds it (the same doubles).
-group_sums = Extension(
-    "skmotion.utils._group_sums",
-    ["skmotion/utils/_group_sums.pyx"],
-    extra_compile_args=["-O3", "-ffp-contract=off"],
-)
+group_sums = module("skmotion.utils._group_sums", "-ffp-contract=off")
 # A node's rows reordered in place along the permutation's cycles (tree/_build/_permute):
 # the build keeps no second copy of the frames.
-permute = Extension(
-    "skmotion.tree._build._permute",
-    ["skmotion/tree/_build/_permute.pyx"],
-    extra_compile_args=["-O3"],
-)
+permute = module("skmotion.tree._build._permute")
 # A tree node's moments (centred in cached chunks, one dsyrk each) and the partition of its
 # rows at a cut, in place and without the GIL (tree/_build/_node_passes, the build's passes).
-node_passes = Extension(
-    "skmotion.tree._build._node_passes",
-    ["skmotion/tree/_build/_node_passes.pyx"],
-    extra_compile_args=["-O3"],
-)
+node_passes = module("skmotion.tree._build._node_passes")
 # Frames walked down the upper layers of a motion tree from their projections, one compiled
 # loop instead of array operations per layer (tree/_encoding/_routing, the encoder's router).
-walk = Extension(
-    "skmotion.tree._encoding._walk",
-    ["skmotion/tree/_encoding/_walk.pyx"],
-    extra_compile_args=["-O3"],
-)
+walk = module("skmotion.tree._encoding._walk")
 # Frame features and window scores of the linear gesture detector, one frame at a time
 # (live/_linear_detector.py).
-live_window = Extension(
-    "skmotion.live._window_kernel",
-    ["skmotion/live/_window_kernel.pyx"],
-    extra_compile_args=["-O3"],
-)
+live_window = module("skmotion.live._window_kernel")
 # The best label path of a long take under a switch penalty (live/_segmenter.py).
-live_path = Extension(
-    "skmotion.live._switch_path",
-    ["skmotion/live/_switch_path.pyx"],
-    extra_compile_args=["-O3"],
-)
+live_path = module("skmotion.live._switch_path")
 # Forward kinematics, one pass over frames and joints (kinematics/_forward.py).
-forward_loops = Extension(
-    "skmotion.kinematics._forward_loops",
-    ["skmotion/kinematics/_forward_loops.pyx"],
-    extra_compile_args=["-O3"],
-)
+forward_loops = module("skmotion.kinematics._forward_loops")
 setup(
     ext_modules=cythonize(
         [
