@@ -78,6 +78,9 @@ node_passes = module("skmotion.tree._build._node_passes")
 # Frames walked down the upper layers of a motion tree from their projections, one compiled
 # loop instead of array operations per layer (tree/_encoding/_routing, the encoder's router).
 walk = module("skmotion.tree._encoding._walk")
+# The encoder's residuals, moments and magnitude check, one pass over each clip's frames
+# (tree/_encoding/_histograms); no contraction: the doubles of the NumPy expressions.
+readout_passes = module("skmotion.tree._encoding._readout_passes", "-ffp-contract=off")
 # Frame features and window scores of the linear gesture detector, one frame at a time
 # (live/_linear_detector.py).
 live_window = module("skmotion.live._window_kernel")
@@ -98,6 +101,7 @@ setup(
             permute,
             node_passes,
             walk,
+            readout_passes,
             live_window,
             live_path,
             forward_loops,

@@ -327,7 +327,11 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         if "tree_" not in self.__dict__:  # sklearn's check costs more than a one-clip encoding
             check_is_fitted(self, "tree_")
         clips = check_clips(X, estimator=self)
-        frames, offsets = stack_clips(clips)
+        if len(clips) == 1:  # transform only reads the frames: one clip needs no stacked copy
+            frames, offsets = clips[0], np.array([0, len(clips[0])], dtype=np.intp)
+        else:
+            frames, offsets = stack_clips(clips)
+        frames = np.asarray(frames, dtype=np.float64)  # float32 clips: converted once, here
         # the raw values, then in training spreads: one maximum and minimum per clip for both
         checks = [(0.0, 1.0, None), (self.moment_center_, self.moment_scale_, _SPREADS_OVERFLOW)]
         check_stacked_magnitude(frames, offsets, self, checks)
@@ -395,7 +399,10 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         if plan is None or plan[0] is not self.tree_:
             layer_sets = (self.layers_, self.transition_layers_, self.residual_layers_)
             routed = np.array(sorted({int(v) for layers in layer_sets for v in layers}), np.intp)
-            plan = (self.tree_, routed, np.searchsorted(routed, self.residual_layers_))
+            columns = np.searchsorted(routed, self.residual_layers_)
+            if len(columns) and (np.diff(columns) == 1).all():  # a view of the nodes, no copy
+                columns = slice(int(columns[0]), int(columns[-1]) + 1)
+            plan = (self.tree_, routed, columns)
             self._plan = plan
         return plan[1:]
 

@@ -9,6 +9,7 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
+from skmotion.tree._encoding._readout_passes import moment_rows, residual_rows
 from skmotion.utils._group_sums import group_sums
 
 __all__ = [
@@ -127,18 +128,23 @@ def residual_features(frames, nodes, offsets, means, center, scale, power):
     -------
     features : ndarray of shape (n_clips, sum(n_nodes(layer) * n_channels))
     """
-    n_clips = len(offsets) - 1
-    clip_weights = _clip_weights(offsets)
+    # one compiled pass per layer (_readout_passes: the doubles of the NumPy expressions
+    # sum (x - c) / s - mean = (sum x - share c) / s - share mean, share = sum 1 / n, then the
+    # signed square root and the unit norm); on a clip of a few dozen frames their forty
+    # array operations' fixed costs were most of the encoder's call
+    frames = np.ascontiguousarray(frames, dtype=np.float64)
+    offsets = np.ascontiguousarray(offsets, dtype=np.intp)
+    nodes = np.asarray(nodes, dtype=np.intp)
+    compiled = power in (0.5, 1.0)  # other powers: NumPy's pow, whose rounding may differ
     blocks = []
     for j, mean in enumerate(means):
-        k = len(mean)
-        # one pass sums every (clip, node) group of raw frames;
-        # sum (x - c) / s - mean = (sum x - share c) / s - share mean, share = sum 1 / n
-        (sums,), share = _node_averages([frames], nodes[:, j], clip_weights, k)
-        block = ((sums - share * center) / scale).reshape(n_clips, k, -1)
-        block = (block - share.reshape(n_clips, k, 1) * mean).reshape(n_clips, -1)
-        blocks.append(_signed_power_unit_norm(block, power))
-    return np.concatenate(blocks, axis=1) if blocks else np.zeros((n_clips, 0))
+        block = residual_rows(
+            frames, nodes[:, j], offsets, mean, center, scale, compiled, power == 0.5
+        )
+        blocks.append(block if compiled else _signed_power_unit_norm(block, power))
+    if len(blocks) == 1:
+        return blocks[0]
+    return np.concatenate(blocks, axis=1) if blocks else np.zeros((len(offsets) - 1, 0))
 
 
 def _signed_power_unit_norm(block, power):
@@ -184,44 +190,16 @@ def moment_features(frames, offsets, center, scale, order, pyramid=(1,)):
         The means cell by cell (level by level, cells in time order, each cell
         every channel), then the root mean squares.
     """
-    lengths = offsets[1:] - offsets[:-1]  # np.diff, without its checks
-    clip = np.repeat(np.arange(len(lengths)), lengths)
-    # one centred copy, squared in place, the scale applied to the sums: a pass over a batch's
-    # frames costs as much as the sums themselves
-    centred = np.subtract(frames, center)
-    blocks = [
-        _cell_means(centred, clip, lengths, parts) / (np.tile(scale, parts) if parts > 1 else scale)
-        for parts in pyramid
-    ]
-    if order >= 2:
-        np.square(centred, out=centred)
-        mean_squares = group_sums(centred, clip, 1.0 / lengths[clip], len(lengths))
-        blocks.append(np.sqrt(mean_squares) / scale - 1.0)
-    return np.concatenate(blocks, axis=1)
-
-
-def _cell_means(centred, clip, lengths, parts):
-    """Per clip, the mean of each channel over each of ``parts`` equal spans of its frames.
-
-    Frame ``t`` of a clip of ``n`` frames is in cell ``t * parts // n`` (as the
-    occupancy pyramid cuts it); a cell that gets no frame (``n < parts``) takes
-    the mean of the frame that spans it, ``floor(c * n / parts)``, so short clips
-    still give every column. Returns ``(n_clips, parts * n_channels)``, cells in
-    time order.
-    """
-    n_clips = len(lengths)
-    if parts == 1:  # the clips themselves: no cell is empty
-        return group_sums(centred, clip, 1.0 / lengths[clip], n_clips)
-    starts = np.concatenate([[0], np.cumsum(lengths)[:-1]])
-    cell = (np.arange(len(clip)) - starts[clip]) * parts // lengths[clip]
-    key = clip * parts + cell
-    size = np.bincount(key, minlength=n_clips * parts)
-    means = group_sums(centred, key, 1.0 / size[key], n_clips * parts)
-    empty = np.flatnonzero(size == 0)
-    if len(empty):
-        owner, c = np.divmod(empty, parts)
-        means[empty] = centred[starts[owner] + c * lengths[owner] // parts]
-    return means.reshape(n_clips, parts * centred.shape[1])
+    # one compiled pass over each clip's frames (_readout_passes), the doubles of
+    # (sum over a cell of (x - center) / its frames) / scale and sqrt(mean (x - center)^2) / scale
+    return moment_rows(
+        np.ascontiguousarray(frames, dtype=np.float64),
+        np.ascontiguousarray(offsets, dtype=np.intp),
+        center,
+        scale,
+        order,
+        np.asarray(pyramid, dtype=np.intp),
+    )
 
 
 def _clip_weights(offsets):
