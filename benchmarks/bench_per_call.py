@@ -9,8 +9,10 @@ synthetic motions (joint angles without the root):
   also ``stream(mode="exact")``;
 - ``MotionTreeEncoder()``: milliseconds of ``transform`` per clip when all test clips
   go in one call, and when each goes in its own call, and their ratio; the two are
-  timed in 9 alternated rounds (a change of load between them would enter the ratio),
-  and the median of the rounds' ratios is given too.
+  timed in 21 alternated rounds (a change of load between them would enter the ratio):
+  the ratio of the best times and the median of the rounds' ratios, both printed. The
+  features of every test clip, one per call, are checked to be the batch's doubles
+  (``np.array_equal``).
 
 Times are CPU seconds of this process (``time.process_time``), the best of 5 repeats
 (of the rounds, for the encoder), so a busy machine inflates them less than wall time
@@ -18,6 +20,7 @@ would. Results:
 ``results/per_call.{csv,md}``. Run: ``python benchmarks/bench_per_call.py``.
 """
 
+import os
 import sys
 import time
 from pathlib import Path
@@ -30,7 +33,7 @@ from _common import SHARED_DATA, write_results  # noqa: E402
 from skmotion.datasets import make_motions  # noqa: E402
 from skmotion.tree import MotionTreeEncoder, MotionTreeHMM  # noqa: E402
 
-ROUNDS = 9  # alternated rounds of the encoder's batched and one-clip calls
+ROUNDS = 21  # alternated rounds of the encoder's batched and one-clip calls
 
 
 def data():
@@ -55,6 +58,7 @@ def best(call, repeats=5):
 
 def main():
     name, Xtr, ytr, Xte = data()
+    load_at_start = os.getloadavg()[0]
     rows = []
     model = MotionTreeHMM().fit(Xtr, ytr)
     start = time.process_time()
@@ -71,10 +75,12 @@ def main():
                 "batched ms per clip": "",
                 "one clip / batched per clip": "",
                 "median of the rounds' ratios": "",
+                "one per call = batched": "",
             }
         )
     encoder = MotionTreeEncoder().fit(Xtr)
-    encoder.transform(Xte[:1])
+    batch = encoder.transform(Xte)
+    identical = np.array_equal(batch, np.vstack([encoder.transform([c]) for c in Xte]))
     one_clip = Xte[:200]
     # alternated rounds, so a change of the machine's load between the two measurements
     # does not enter their ratio: the best of each, and the median of the rounds' ratios
@@ -85,6 +91,13 @@ def main():
             best(lambda: [encoder.transform([c]) for c in one_clip], repeats=1) / len(one_clip)
         )
     ratios = np.array(single) / np.array(batched)
+    print(
+        f"MotionTreeEncoder().transform: one clip per call {1e3 * min(single):.3f} ms, batched "
+        f"{1e3 * min(batched):.3f} ms per clip; ratio of the best times "
+        f"{min(single) / min(batched):.2f}, median of {ROUNDS} rounds' ratios "
+        f"{np.median(ratios):.2f}; one per call = batched (np.array_equal, {len(Xte)} clips): "
+        f"{identical}; load average {load_at_start:.1f} at the start"
+    )
     rows.append(
         {
             "data": name,
@@ -94,6 +107,7 @@ def main():
             "batched ms per clip": 1e3 * min(batched),
             "one clip / batched per clip": min(single) / min(batched),
             "median of the rounds' ratios": float(np.median(ratios)),
+            "one per call = batched": identical,
         }
     )
     n_frames = sum(len(c) for c in Xte) / len(Xte)
@@ -104,7 +118,7 @@ def main():
             f"{len(Xtr)} training clips, {len(Xte)} test clips of {n_frames:.0f} frames on "
             f"average, {Xte[0].shape[1]} channels. CPU time (process_time), best of 5 (the "
             f"encoder: of {ROUNDS} alternated rounds, and the median of their ratios); "
-            "OPENBLAS/OMP/MKL threads = 1."
+            f"OPENBLAS/OMP/MKL threads = 1. Load average {load_at_start:.1f} at the start."
         ),
     )
     return rows
