@@ -11,7 +11,8 @@ reports the seconds and its peak resident memory (``VmHWM``, the frames included
   threads (the same tree);
 - ``MotionTree.build``: the same with the default ``copy=True`` (a copy of the frames);
 - ``MotionTreeEncoder().fit``: the encoder with its defaults, from clips of 100 frames
-  (views into the frame array);
+  (views into the frame array); ``MotionTreeEncoder(residual_order=2).fit`` the same
+  with the residuals' second order (a routing of all training frames after the build);
 - sklearn's ``BisectingKMeans(256)`` and ``MiniBatchKMeans(256)`` (``random_state=0``,
   defaults otherwise), the frame vocabularies of the same size.
 
@@ -23,8 +24,8 @@ build of the skmotion source tree SRC (for example an older checkout) on the sam
 frames. The two copying builds stop at 10^6 frames (their memory figure is clear
 there). The growth exponent of each method is the slope of log seconds against log
 frames over the sizes it ran. ``--methods`` runs some of them (``tree_in_place``,
-``tree_threads``, ``tree``, ``encoder``, ``bisecting``, ``minibatch``). Each result row
-carries the load average when its fit ended. Results:
+``tree_threads``, ``tree``, ``encoder``, ``encoder2``, ``bisecting``, ``minibatch``).
+Each result row carries the load average when its fit ended. Results:
 ``results/<--name, default scaling_frames>.{csv,md}``.
 Run: ``python benchmarks/bench_scaling_frames.py``.
 """
@@ -49,6 +50,7 @@ METHODS = {
     "MotionTree.build(copy=False, n_jobs=2)": "tree_threads",
     "MotionTree.build (copy)": "tree",
     "MotionTreeEncoder().fit": "encoder",
+    "MotionTreeEncoder(residual_order=2).fit": "encoder2",
     "BisectingKMeans(256)": "bisecting",
     "MiniBatchKMeans(256)": "minibatch",
 }
@@ -93,6 +95,11 @@ def worker(method, n):
         "before": lambda: MotionTree.build(frames, **build).n_nodes[-1],
         "encoder": lambda: (
             MotionTreeEncoder()
+            .fit([frames[s : s + 100] for s in range(0, n, 100)])
+            .tree_.n_nodes[-1]
+        ),
+        "encoder2": lambda: (
+            MotionTreeEncoder(residual_order=2)
             .fit([frames[s : s + 100] for s in range(0, n, 100)])
             .tree_.n_nodes[-1]
         ),

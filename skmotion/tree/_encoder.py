@@ -300,9 +300,9 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         self._residual_means = [self.tree_.means(layer) for layer in self.residual_layers_]
         self._residual_variances = []
         if self.residual_order == 2 and len(self.residual_layers_):
-            raw, _ = stack_clips(clips)  # routed as transform routes them: the raw frames
-            nodes = self._router.route(raw, self.residual_layers_)
-            del raw
+            # routed as transform routes them (the raw frames), a group of clips at a time:
+            # no second stacked copy of the frames
+            nodes = self._router.route_clips(clips, self.residual_layers_)
             self._residual_variances = node_variances(z, nodes, self._residual_means)
         orders = 2 if self._residual_variances else 1
         n_residual = self.tree_.n_nodes[self.residual_layers_].sum() * orders

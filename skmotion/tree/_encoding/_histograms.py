@@ -12,6 +12,9 @@ import scipy.sparse as sp
 from skmotion.tree._encoding._readout_passes import moment_rows, residual_rows
 from skmotion.utils._group_sums import group_sums
 
+# rows per block of node_variances' squared deviations (bounds its temporaries)
+_ROWS_PER_BLOCK = 1 << 15
+
 __all__ = [
     "feature_blocks",
     "histogram_features",
@@ -236,7 +239,10 @@ def node_variances(z, nodes, means):
         node = nodes[:, j]
         count = np.bincount(node, minlength=len(mean))[:, None]
         squares = np.zeros_like(mean)
-        np.add.at(squares, node, (z - mean[node]) ** 2)
+        # in blocks of rows (the same sums in the same order): the temporaries are a block's
+        for start in range(0, len(z), _ROWS_PER_BLOCK):
+            rows = slice(start, start + _ROWS_PER_BLOCK)
+            np.add.at(squares, node[rows], (z[rows] - mean[node[rows]]) ** 2)
         spread = np.maximum(squares / np.maximum(count, 1), 1e-3)
         variances.append(np.where(count > 1, spread, 1.0))
     return variances

@@ -108,6 +108,35 @@ class TreeRouter:
             out[block] = self._route_block(frames[block], layers)
         return out
 
+    def route_clips(self, clips, layers=None):
+        """:meth:`route` of the clips' frames, one clip after the other.
+
+        The clips are routed in groups of about 32,768 frames (each frame's nodes do not
+        depend on the others routed with it), so no stacked copy of all frames is made.
+
+        Parameters
+        ----------
+        clips : list of ndarray of shape (n_frames_i, n_channels)
+        layers : array-like of int, default=None
+            As for :meth:`route`.
+
+        Returns
+        -------
+        nodes : ndarray of shape (sum(n_frames_i), n_selected_layers)
+        """
+        layers = (
+            np.arange(self.n_layers) if layers is None else np.ascontiguousarray(layers, np.intp)
+        )
+        out = np.empty((sum(len(clip) for clip in clips), len(layers)), dtype=np.intp)
+        group, size, start = [], 0, 0
+        for i, clip in enumerate(clips):
+            group.append(clip)
+            size += len(clip)
+            if size >= _CHUNK or i == len(clips) - 1:
+                out[start : start + size] = self.route(np.concatenate(group), layers)
+                group, size, start = [], 0, start + size
+        return out
+
     def _route_block(self, frames, layers):
         out = np.empty((len(frames), len(layers)), dtype=np.intp)
         node = np.zeros(len(frames), dtype=np.intp)  # tree node ids, from the root
