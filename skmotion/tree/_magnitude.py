@@ -15,6 +15,9 @@ rather than a number:
   rows, ``-inf``); ``score_samples``, whose values are the answer, refuses them.
 """
 
+import math
+import sys
+
 import numpy as np
 
 from skmotion.tree._encoding._readout_passes import extremes_within
@@ -29,7 +32,8 @@ def overflow_limit(clips):
     """The largest absolute value whose squares, summed over every frame and channel
     of ``clips`` (and after centring, which can double a value), stay finite."""
     n_values = sum(clip.size for clip in clips)
-    return float(np.sqrt(np.finfo(np.float64).max / (4.0 * max(n_values, 1))))
+    # math's correctly rounded sqrt of the largest double: NumPy's value, without its calls
+    return math.sqrt(sys.float_info.max / (4.0 * max(n_values, 1)))
 
 
 def check_magnitude(clips, estimator, *, center=0.0, scale=1.0, limit=None, why=None):
