@@ -4,9 +4,10 @@ Offers :class:`TreeRouter` (``_routing.py``: every layer's node of all frames in
 one pass over the layers, the standardisation folded into the splits), the
 per-clip blocks over routed node labels (``_histograms.py``: occupancy with its
 temporal pyramid, transitions, first- and second-order residuals, the clip's
-moments) and the encoder's columns (``_columns.py``: which layers it encodes,
-the depth to build, the columns' names). :class:`MotionTreeEncoder`
-(``tree/_encoder.py``) is the estimator that holds them.
+moments; the residuals, the moments and the magnitude check are compiled passes over
+each clip's frames in ``_readout_passes.pyx``) and the encoder's columns
+(``_columns.py``: which layers it encodes, the depth to build, the columns' names).
+:class:`MotionTreeEncoder` (``tree/_encoder.py``) is the estimator that holds them.
 """
 
 from skmotion.tree._encoding._columns import build_depth, feature_names
