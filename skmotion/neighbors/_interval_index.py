@@ -283,6 +283,7 @@ class IntervalIndex:
         return child
 
     def _insert_batch(self, first, last, ids):
+        """The (materialised leaf, item id) pairs of some items, creating missing nodes."""
         item = np.arange(len(ids))
         node = np.ones(len(ids), dtype=np.intp)
         for level in range(self._n_tree):
@@ -291,19 +292,23 @@ class IntervalIndex:
             offset = np.arange(len(repeat)) - np.repeat(np.cumsum(span) - span, span)
             item, node = item[repeat], node[repeat]
             node = self._children(level, node, lo[repeat] + offset)
-        self._add_block(node, ids[item])
+        return node.astype(np.int32), ids[item]
 
     @staticmethod
     def _block(leaf, items):
-        """CSR block from (leaf, item) pairs; a stable sort keeps items increasing per leaf."""
-        order = np.argsort(leaf, kind="stable")
-        leaf, items = leaf[order], items[order]
-        starts = np.flatnonzero(np.r_[True, leaf[1:] != leaf[:-1]])
-        return (
-            leaf[starts].astype(np.int32),
-            np.r_[starts, len(leaf)].astype(np.int64),
-            items.astype(np.int32),
-        )
+        """CSR block from (leaf, item) pairs, items increasing within a leaf.
+
+        One in-place sort of ``leaf * base + item`` (int64): cheaper than a
+        stable argsort and two gathers, and the same order.
+        """
+        base = int(items.max()) + 1 if len(items) else 1
+        key = leaf.astype(np.int64) * base
+        key += items
+        key.sort()
+        items = (key % base).astype(np.int32)
+        key //= base  # now the leaves, in place
+        starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+        return key[starts].astype(np.int32), np.r_[starts, len(key)].astype(np.int64), items
 
     def _add_block(self, leaf, items):
         self._blocks.append(self._block(leaf, items))
@@ -337,8 +342,11 @@ class IntervalIndex:
         # Each item lands in prod(span) materialised leaves: batch items to bound the pairs.
         n_leaves = np.prod(spans[:, : self._n_tree], axis=1)
         step = np.cumsum(n_leaves) // _PAIRS_PER_STEP
-        for rows in np.split(np.arange(len(ids)), np.flatnonzero(np.diff(step)) + 1):
+        pairs = [
             self._insert_batch(first[rows], last[rows], ids[rows])
+            for rows in np.split(np.arange(len(ids)), np.flatnonzero(np.diff(step)) + 1)
+        ]
+        self._add_block(*(np.concatenate(p) for p in zip(*pairs)))
         deep = np.stack([first[:, self._n_tree :], last[:, self._n_tree :]], axis=1)
         self._deep = _appended(self._deep, self.n_items, deep.astype(np.int32))
         self.n_items += len(ids)
