@@ -33,6 +33,8 @@ from bisect import bisect_right
 
 import numpy as np
 
+from skmotion.neighbors._leaf_kernels import filter_items
+
 __all__ = ["IntervalIndex", "entry_edges", "tree_levels"]
 
 _EMPTY = np.zeros(0, dtype=np.int32)
@@ -346,7 +348,9 @@ class IntervalIndex:
             self._insert_batch(first[rows], last[rows], ids[rows])
             for rows in np.split(np.arange(len(ids)), np.flatnonzero(np.diff(step)) + 1)
         ]
-        self._add_block(*(np.concatenate(p) for p in zip(*pairs)))
+        leaves, items = (np.concatenate(p) for p in zip(*pairs))
+        del pairs  # the pieces: the sort's memory is the peak of a large insertion
+        self._add_block(leaves, items)
         deep = np.stack([first[:, self._n_tree :], last[:, self._n_tree :]], axis=1)
         self._deep = _appended(self._deep, self.n_items, deep.astype(np.int32))
         self.n_items += len(ids)
@@ -399,9 +403,7 @@ class IntervalIndex:
         """The items whose first and last entries hold ``entries`` at every filtered level."""
         if not len(entries) or not len(items):
             return items
-        deep = self._deep[items]
-        keep = ((deep[:, 0] <= entries) & (entries <= deep[:, 1])).all(axis=1)
-        return items[keep]
+        return filter_items(np.ascontiguousarray(items, dtype=np.int32), self._deep, entries)
 
     def leaf_items(self, leaf):
         """Sorted ids of the items in a leaf, as an ``int32`` array."""
