@@ -87,3 +87,50 @@ def euclidean_block(
                     total += d * d
                 out[r, c] = sqrt(total)
     return out_array
+
+
+def smallest_columns(const double[:, ::1] distances, Py_ssize_t n):
+    """Per row, the columns of the ``n`` smallest distances, increasing, ties by column.
+
+    What a stable argsort of each row gives in its first ``n`` places, by insertion
+    into a sorted buffer of ``n`` (one pass over the row: ``n`` is small).
+
+    Parameters
+    ----------
+    distances : ndarray of shape (n_rows, n_columns)
+        No NaN (not checked).
+    n : int
+        From 1 to ``n_columns``.
+
+    Returns
+    -------
+    columns : ndarray of intp of shape (n_rows, n)
+    nearest : ndarray of shape (n_rows, n)
+    """
+    cdef Py_ssize_t n_rows = distances.shape[0], n_columns = distances.shape[1]
+    cdef Py_ssize_t r, c, count, at
+    cdef double d
+    if not 1 <= n <= n_columns:
+        raise ValueError(f"n must be from 1 to {n_columns}; got {n}.")
+    columns_array = np.empty((n_rows, n), dtype=np.intp)
+    nearest_array = np.empty((n_rows, n))
+    cdef Py_ssize_t[:, ::1] columns = columns_array
+    cdef double[:, ::1] nearest = nearest_array
+    with nogil:
+        for r in range(n_rows):
+            count = 0
+            for c in range(n_columns):
+                d = distances[r, c]
+                if count == n and not d < nearest[r, n - 1]:
+                    continue
+                at = count if count < n else n - 1
+                # Shift the larger ones up; an equal one stays before (the lower column).
+                while at > 0 and nearest[r, at - 1] > d:
+                    nearest[r, at] = nearest[r, at - 1]
+                    columns[r, at] = columns[r, at - 1]
+                    at -= 1
+                nearest[r, at] = d
+                columns[r, at] = c
+                if count < n:
+                    count += 1
+    return columns_array, nearest_array

@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given
 from hypothesis import strategies as st
 from scipy.spatial.distance import cdist
-from skmotion.neighbors._leaf_kernels import euclidean_block, filter_items
+from skmotion.neighbors._leaf_kernels import euclidean_block, filter_items, smallest_columns
 
 
 @given(st.integers(0, 10_000), st.integers(1, 12))
@@ -37,3 +37,15 @@ def test_filter_items_keeps_the_items_holding_the_entries(seed, n_levels):
         if all(deep[i, 0, j] <= entries[j] <= deep[i, 1, j] for j in range(n_levels))
     ]
     assert filter_items(items, deep, entries).tolist() == expected
+
+
+@given(st.integers(0, 10_000), st.integers(1, 6), st.integers(1, 9))
+def test_smallest_columns_equal_a_stable_argsort(seed, n_rows, n_columns):
+    # Few distinct values (and infinities) so that ties are common: the lower column first.
+    rng = np.random.default_rng(seed)
+    distances = rng.choice([0.0, 0.5, 1.0, 2.0, np.inf], size=(n_rows, n_columns))
+    n = int(rng.integers(1, n_columns + 1))
+    columns, nearest = smallest_columns(distances, n)
+    expected = np.argsort(distances, axis=1, kind="stable")[:, :n]
+    np.testing.assert_array_equal(columns, expected)
+    np.testing.assert_array_equal(nearest, np.take_along_axis(distances, expected, axis=1))
