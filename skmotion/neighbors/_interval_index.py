@@ -114,6 +114,12 @@ def entry_edges(low, high, width, max_entries):
     return low + width * np.arange(1, n_entries)
 
 
+def _entry_type(n_entries):
+    """The smallest signed integer type holding entry numbers below each of ``n_entries``."""
+    largest = max(n_entries, default=1) - 1
+    return next(t for t in (np.int8, np.int16, np.int32) if largest <= np.iinfo(t).max)
+
+
 def _appended(buffer, n_filled, rows):
     """``buffer`` with ``rows`` written after its first ``n_filled`` rows, grown by doubling."""
     need = n_filled + len(rows)
@@ -178,8 +184,8 @@ class IntervalIndex:
         self._n_leaves = 1
         self._blocks = []  # (leaf ids, offsets, items), oldest (lowest item ids) first
         # The filtered levels: each item's first and last entry, and the radix of a leaf's name.
-        n_deep = self.n_levels - self._n_tree
-        self._deep = np.zeros((0, 2, n_deep), dtype=np.int32)
+        deep_entries = self.n_entries[self._n_tree :]
+        self._deep = np.zeros((0, 2, len(deep_entries)), dtype=_entry_type(deep_entries))
         self._stride = math.prod(self.n_entries[self._n_tree :])
         self._paper_pairs = 0
         self.n_items = 0
@@ -209,7 +215,7 @@ class IntervalIndex:
         item = np.concatenate([b[2] for b in self._blocks]).astype(np.intp)
         node = node.astype(np.int64)
         for level in range(self.n_levels - self._n_tree):
-            lo, hi = self._deep[item, 0, level], self._deep[item, 1, level]
+            lo, hi = (self._deep[item, side, level].astype(np.intp) for side in (0, 1))
             span = hi - lo + 1
             repeat = np.repeat(np.arange(len(item)), span)
             offset = np.arange(len(repeat)) - np.repeat(np.cumsum(span) - span, span)
@@ -352,7 +358,7 @@ class IntervalIndex:
         del pairs  # the pieces: the sort's memory is the peak of a large insertion
         self._add_block(leaves, items)
         deep = np.stack([first[:, self._n_tree :], last[:, self._n_tree :]], axis=1)
-        self._deep = _appended(self._deep, self.n_items, deep.astype(np.int32))
+        self._deep = _appended(self._deep, self.n_items, deep.astype(self._deep.dtype))
         self.n_items += len(ids)
         return ids.astype(np.intp)
 
@@ -397,7 +403,7 @@ class IntervalIndex:
         for n in reversed(self.n_entries[self._n_tree :]):
             code, entry = divmod(code, n)
             entries.append(entry)
-        return leaf, np.array(entries[::-1], dtype=np.int32)
+        return leaf, np.array(entries[::-1], dtype=self._deep.dtype)
 
     def _filtered(self, items, entries):
         """The items whose first and last entries hold ``entries`` at every filtered level."""

@@ -15,16 +15,23 @@ import numpy as np
 from libc.math cimport sqrt
 
 
-def filter_items(const int[::1] items, const int[:, :, ::1] deep, const int[::1] entries):
+ctypedef fused entry_t:
+    signed char
+    short
+    int
+
+
+def filter_items(const int[::1] items, const entry_t[:, :, ::1] deep, const entry_t[::1] entries):
     """The items whose ``deep[item, 0, l] <= entries[l] <= deep[item, 1, l]`` at every level ``l``.
 
     Parameters
     ----------
     items : ndarray of int32
         Item ids (in range; not checked), in the order they are returned.
-    deep : ndarray of int32 of shape (n_items, 2, n_levels)
-        Each item's first and last entry per level.
-    entries : ndarray of int32 of shape (n_levels,)
+    deep : ndarray of int8, int16 or int32 of shape (n_items, 2, n_levels)
+        Each item's first and last entry per level (int8 for up to 127 entries:
+        6 bytes per item at 3 levels, so the array of 10^6 items stays in cache).
+    entries : ndarray of the same type, of shape (n_levels,)
         The query's entry per level.
 
     Returns

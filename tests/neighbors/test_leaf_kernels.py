@@ -24,12 +24,12 @@ def test_euclidean_block_keeps_small_distances():
     np.testing.assert_allclose(out, [[0.0, 1e-6]], rtol=1e-6)
 
 
-@given(st.integers(0, 10_000), st.integers(1, 4))
-def test_filter_items_keeps_the_items_holding_the_entries(seed, n_levels):
+@given(st.integers(0, 10_000), st.integers(1, 4), st.sampled_from([np.int8, np.int16, np.int32]))
+def test_filter_items_keeps_the_items_holding_the_entries(seed, n_levels, dtype):
     rng = np.random.default_rng(seed)
     first = rng.integers(0, 5, (40, n_levels))
-    deep = np.stack([first, first + rng.integers(0, 3, (40, n_levels))], axis=1).astype(np.int32)
-    entries = rng.integers(0, 7, n_levels).astype(np.int32)
+    deep = np.stack([first, first + rng.integers(0, 3, (40, n_levels))], axis=1).astype(dtype)
+    entries = rng.integers(0, 7, n_levels).astype(dtype)
     items = np.sort(rng.permutation(40)[:25]).astype(np.int32)
     expected = [
         i
