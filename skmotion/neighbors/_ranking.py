@@ -39,6 +39,9 @@ def smallest_k(distances, n):
     numpy's partition, sort and three gathers cost more than a small leaf's
     distances).
     """
+    if n == 1:  # argmin: the first of equal minima, i.e. the lower column
+        columns = distances.argmin(axis=1)
+        return columns[:, None], distances[np.arange(len(distances)), columns][:, None]
     return smallest_columns(np.ascontiguousarray(distances, dtype=np.float64), n)
 
 
@@ -62,9 +65,8 @@ def nearest_in_leaves(leaves, rank_leaf, n_neighbors, *, leaves_per_task=32, n_j
     -------
     distances, indices : ndarray of shape (n_queries, n_neighbors)
     """
-    if len(leaves) == 1:  # one query: no grouping, no tasks
-        with small_blas():
-            return rank_leaf(leaves[0], np.zeros(1, dtype=np.intp))
+    if len(leaves) == 1:  # one query: no grouping, no tasks, and no BLAS (compiled loops)
+        return rank_leaf(leaves[0], np.zeros(1, dtype=np.intp))
     order = np.argsort(leaves, kind="stable")
     ordered = leaves[order]
     bounds = np.flatnonzero(np.concatenate(([True], ordered[1:] != ordered[:-1], [True])))
