@@ -120,6 +120,12 @@ def _entry_type(n_entries):
     return next(t for t in (np.int8, np.int16, np.int32) if largest <= np.iinfo(t).max)
 
 
+def _expanded(span):
+    """Row ``i`` repeated ``span[i]`` times, and the offsets ``0 .. span[i] - 1`` of the copies."""
+    repeat = np.repeat(np.arange(len(span)), span)
+    return repeat, np.arange(len(repeat)) - np.repeat(np.cumsum(span) - span, span)
+
+
 def _appended(buffer, n_filled, rows):
     """``buffer`` with ``rows`` written after its first ``n_filled`` rows, grown by doubling."""
     need = n_filled + len(rows)
@@ -217,8 +223,7 @@ class IntervalIndex:
         for level in range(self.n_levels - self._n_tree):
             lo, hi = (self._deep[item, side, level].astype(np.intp) for side in (0, 1))
             span = hi - lo + 1
-            repeat = np.repeat(np.arange(len(item)), span)
-            offset = np.arange(len(repeat)) - np.repeat(np.cumsum(span) - span, span)
+            repeat, offset = _expanded(span)
             item = item[repeat]
             entries = self.n_entries[self._n_tree + level]
             node = np.unique(node[repeat] * entries + lo[repeat] + offset, return_inverse=True)[1]
@@ -296,8 +301,7 @@ class IntervalIndex:
         node = np.ones(len(ids), dtype=np.intp)
         for level in range(self._n_tree):
             lo, span = first[item, level], last[item, level] - first[item, level] + 1
-            repeat = np.repeat(np.arange(len(item)), span)
-            offset = np.arange(len(repeat)) - np.repeat(np.cumsum(span) - span, span)
+            repeat, offset = _expanded(span)
             item, node = item[repeat], node[repeat]
             node = self._children(level, node, lo[repeat] + offset)
         return node.astype(np.int32), ids[item]
