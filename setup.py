@@ -59,6 +59,10 @@ position_frame = module("skmotion.preprocessing._position_frame_loops")
 leading = module("skmotion.decomposition._leading")
 # psi distances of a leaf's queries to its candidates (neighbors/_ranking.py).
 psi_rank = module("skmotion.neighbors._psi_rank")
+# A leaf's items filtered by the levels the interval index does not materialise, and
+# Euclidean distances of a leaf's queries to its candidates (neighbors/_interval_index.py,
+# neighbors/_stored_clips.py).
+leaf_kernels = module("skmotion.neighbors._leaf_kernels")
 # Sliding window statistics and subsequence DTW of the occurrence search
 # (neighbors/_occurrences.py); no errno from sqrt and no trapping comparisons, so the
 # distance loop's selects are branch-free and the loop is vectorised.
@@ -96,6 +100,7 @@ setup(
             position_frame,
             leading,
             psi_rank,
+            leaf_kernels,
             occurrence_loops,
             group_sums,
             permute,

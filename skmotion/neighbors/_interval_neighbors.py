@@ -485,7 +485,9 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
                 f"X: {type(self).__name__} was fitted on {expected}; pass the same kind."
             )
         if self.input_kind_ == "table":
-            table = validate_data(self, X, reset=reset, dtype=np.float64)
+            table = None if reset else self._checked_table(X)
+            if table is None:
+                table = validate_data(self, X, reset=reset, dtype=np.float64)
             if reset:
                 self.n_levels_ = self._resolve_levels(table.shape[1], "feature(s) of X")
             return table, table
@@ -498,6 +500,25 @@ class IntervalIndexNeighbors(ClipEstimatorMixin, ClassifierMixin, BaseEstimator)
             self.projection_ = fit_svd_projection(*spectra, self._n_inputs(limit), weighting)
         tree = svd_project(self.projection_, *spectra)
         return tree, signatures_from_spectra(*spectra, self.k) if ranking else None
+
+    def _checked_table(self, X):
+        """``X`` itself when it is what ``validate_data`` would return unchanged, else None.
+
+        A 2-D float64 array of the fitted width with finite values, fitted
+        without feature names: sklearn's validation of one query costs several
+        times the search (it looks for DataFrames, converts, checks names).
+        """
+        if (
+            type(X) is np.ndarray
+            and X.dtype == np.float64
+            and X.ndim == 2
+            and X.shape[0] > 0
+            and X.shape[1] == self.n_features_in_
+            and "feature_names_in_" not in vars(self)
+            and np.isfinite(X).all()
+        ):
+            return X
+        return None
 
     def _weighting(self):
         return "first" if self.features is None else self.features.weighting

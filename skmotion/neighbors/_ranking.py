@@ -3,6 +3,7 @@
 import numpy as np
 
 from skmotion.decomposition._clip_svd import small_blas
+from skmotion.neighbors._leaf_kernels import smallest_columns
 from skmotion.neighbors._psi import psi_from_signatures
 from skmotion.neighbors._psi_rank import psi_distances
 from skmotion.utils._parallel import parallel_map
@@ -34,16 +35,14 @@ def psi_distance_block(query, stored, rows, columns):
 def smallest_k(distances, n):
     """Per row, the columns of the ``n`` smallest distances, ties by column.
 
-    Returns ``(columns, distances)``, both ``(n_rows, n)``, increasing.
+    Returns ``(columns, distances)``, both ``(n_rows, n)``, increasing (compiled:
+    numpy's partition, sort and three gathers cost more than a small leaf's
+    distances).
     """
-    if distances.shape[1] > 4 * n:
-        part = np.argpartition(distances, n - 1, axis=1)[:, :n]
-        part.sort(axis=1)  # equal distances: the lower column first
-    else:
-        part = np.broadcast_to(np.arange(distances.shape[1]), distances.shape)
-    order = np.argsort(np.take_along_axis(distances, part, axis=1), axis=1, kind="stable")[:, :n]
-    chosen = np.take_along_axis(part, order, axis=1)
-    return chosen, np.take_along_axis(distances, chosen, axis=1)
+    if n == 1:  # argmin: the first of equal minima, i.e. the lower column
+        columns = distances.argmin(axis=1)
+        return columns[:, None], distances[np.arange(len(distances)), columns][:, None]
+    return smallest_columns(np.ascontiguousarray(distances, dtype=np.float64), n)
 
 
 def nearest_in_leaves(leaves, rank_leaf, n_neighbors, *, leaves_per_task=32, n_jobs=None):
@@ -66,6 +65,8 @@ def nearest_in_leaves(leaves, rank_leaf, n_neighbors, *, leaves_per_task=32, n_j
     -------
     distances, indices : ndarray of shape (n_queries, n_neighbors)
     """
+    if len(leaves) == 1:  # one query: no grouping, no tasks, and no BLAS (compiled loops)
+        return rank_leaf(leaves[0], np.zeros(1, dtype=np.intp))
     order = np.argsort(leaves, kind="stable")
     ordered = leaves[order]
     bounds = np.flatnonzero(np.concatenate(([True], ordered[1:] != ordered[:-1], [True])))

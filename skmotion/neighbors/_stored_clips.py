@@ -7,8 +7,8 @@ the distances of queries to them.
 """
 
 import numpy as np
-from sklearn.metrics.pairwise import euclidean_distances
 
+from skmotion.neighbors._leaf_kernels import euclidean_block
 from skmotion.neighbors._ranking import psi_distance_block, smallest_k
 
 __all__ = ["GrowableStore", "StoredClips"]
@@ -125,7 +125,8 @@ class StoredClips(GrowableStore):
     def distances(self, ranking, rows, columns):
         """Distances of queries ``rows`` (of their ranking data) to stored clips ``columns``."""
         if "table" in self.names:
-            return euclidean_distances(ranking[rows], self.ranking[columns])
+            rows, columns = (np.ascontiguousarray(i, dtype=np.intp) for i in (rows, columns))
+            return euclidean_block(np.ascontiguousarray(ranking), self.ranking, rows, columns)
         return psi_distance_block(ranking, self.ranking, rows, columns)
 
     def rank_leaf(self, columns, rows, ranking, self_ids, n_neighbors):

@@ -154,11 +154,12 @@ def learn_radius(
         return span.copy(), 1.0
     distance = np.abs(features[first] - features[second])
     a, b = rng.randint(0, len(features), size=(2, _RANDOM_PAIRS))
+    # Gathered once, column by column contiguous (searchsorted reads one column
+    # at a time): the bisection asks for the recall 80 times.
+    query, stored = np.asfortranarray(features[first]), np.asfortranarray(features[second])
 
     def recall_at(radius):
-        keep = surviving(
-            features[first], features[second], radius, low, high, max_entries, width_factor
-        )
+        keep = surviving(query, stored, radius, low, high, max_entries, width_factor)
         return float(weight[keep].sum() / weight.sum())
 
     best = None

@@ -193,3 +193,52 @@ def test_one_leafs_items_equal_those_of_the_many_leaf_look_up(seed, n_insertions
         (alone,) = index.items_of_leaves(np.array([leaf]))
         assert alone.dtype == np.intp
         np.testing.assert_array_equal(alone, items)
+
+
+@given(index_case())
+def test_filtered_levels_equal_the_materialised_tree(case):
+    # Materialising one level and filtering the others gives the paper's tree:
+    # the same candidates, leaf sizes, node counts and pairs as materialising all.
+    from skmotion.neighbors import _interval_index as module
+
+    edges, radius, items, queries, split = case
+    whole = IntervalIndex(edges, radius)
+    whole.insert(items)
+    original = module._LEAVES_PER_ITEM
+    module._LEAVES_PER_ITEM = 0
+    try:
+        filtered = IntervalIndex(edges, radius)
+    finally:
+        module._LEAVES_PER_ITEM = original
+    filtered.insert(items[:split])
+    filtered.insert(items[split:])
+    assert filtered._n_tree == 1
+    leaves = filtered.leaf_of(queries)
+    for a, b in zip(whole.candidates(queries), filtered.candidates(queries)):
+        np.testing.assert_array_equal(a, b)
+    for query, leaf in zip(queries, leaves):
+        np.testing.assert_array_equal(filtered.leaf_of(query[None]), [leaf])
+        np.testing.assert_array_equal(filtered.leaf_items(leaf), whole.candidates(query[None])[0])
+    np.testing.assert_array_equal(
+        filtered.leaf_sizes(leaves), whole.leaf_sizes(whole.leaf_of(queries))
+    )
+    assert filtered.n_nodes == whole.n_nodes
+    assert filtered.n_stored() == whole.n_stored()
+
+
+def test_seven_levels_of_three_entries_materialise_four():
+    # An item meets 3 entries per level: 3^4 = 81 leaves per item are materialised,
+    # not 3^7 = 2187; the deeper three levels are filtered.
+    rng = np.random.default_rng(0)
+    edges = [np.arange(1.0, 10.0)] * 7
+    index = IntervalIndex(edges, [1.0] * 7)
+    items = rng.uniform(0, 10, (200, 7))
+    index.insert(items)
+    assert index._n_tree == 4
+    first, last = index.covering_entries(items)
+    assert index.n_stored() == int(np.prod(last - first + 1, axis=1).sum())
+    materialised = int(sum(len(block[2]) for block in index._blocks))
+    assert materialised == int(np.prod((last - first + 1)[:, :4], axis=1).sum())
+    queries = rng.uniform(0, 10, (30, 7))
+    for query, found in zip(queries, index.candidates(queries)):
+        assert found.tolist() == brute_force_candidates(edges, [1.0] * 7, items, query)

@@ -178,6 +178,38 @@ def test_euclidean_ranking_on_feature_vectors():
         np.testing.assert_allclose(distances[q], np.sort(d)[:4])
 
 
+def test_seven_levels_with_filtered_levels_rank_exactly_one_query_at_a_time():
+    # Default widths on 7 components: an item meets ~3 entries per level, so only
+    # the first levels are materialised and the rest filter; the answers are the
+    # brute-force ranking of each query's candidates (the paper's leaf), and one
+    # query per call (the fast validation path) answers as the batch does.
+    rng = np.random.default_rng(1)
+    centers = rng.normal(size=(100, 8)) * 3
+    y = rng.integers(0, 100, 2000)
+    X = centers[y] + rng.normal(scale=0.3, size=(2000, 8))
+    queries = centers[rng.integers(0, 100, 40)] + rng.normal(scale=0.3, size=(40, 8))
+    index = IntervalIndexNeighbors(n_neighbors=3, random_state=0).fit(X, y)
+    assert index.index_._n_tree < index.n_levels_
+    distances, neighbours = index.kneighbors(queries)
+    for q, cands in enumerate(index.candidates(queries)):
+        assert cands.tolist() == brute_force_candidates(
+            index.index_.edges, index.index_.radius, X, queries[q]
+        )
+        pool = cands if len(cands) >= 3 else np.arange(len(X))
+        d = np.linalg.norm(X[pool] - queries[q], axis=1)
+        np.testing.assert_array_equal(neighbours[q], pool[np.argsort(d, kind="stable")[:3]])
+        np.testing.assert_allclose(distances[q], np.sort(d)[:3], rtol=1e-12)
+        one_d, one_i = index.kneighbors(queries[q : q + 1])
+        np.testing.assert_array_equal(one_i[0], neighbours[q])
+        np.testing.assert_array_equal(one_d[0], distances[q])
+    # The validation a query skips is still done where it matters.
+    with pytest.raises(ValueError, match="NaN"):
+        index.kneighbors(np.full((1, 8), np.nan))
+    with pytest.raises(ValueError, match="features"):
+        index.kneighbors(np.zeros((1, 5)))
+    np.testing.assert_array_equal(index.kneighbors(queries[:5].tolist())[1], neighbours[:5])
+
+
 def test_predict_votes_among_neighbours(repeated):
     clips, target = repeated
     index = IntervalIndexNeighbors(n_levels=5, n_neighbors=3).fit(clips, target)
