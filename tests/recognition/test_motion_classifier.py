@@ -69,9 +69,15 @@ def test_equals_its_steps_run_by_hand(positions):
     encoder = MotionTreeEncoder(
         max_depth=4, layers="all", moment_pyramid=(1, 2, 4), standardize=False, sparse_output=False
     ).fit(S(Mtr))
-    Ftr, Fte = encoder.transform(S(Mtr)), encoder.transform(S(Mte))
+    # the vocabulary, then each clip's channel covariances (np.cov's upper triangle)
+    upper = np.triu_indices(len(scale))
+    cov = lambda M: [np.cov(m, rowvar=False, bias=True)[upper] for m in M]  # noqa: E731
+    Ftr = np.hstack([encoder.transform(S(Mtr)), cov(S(Mtr))])
+    Fte = np.hstack([encoder.transform(S(Mte)), cov(S(Mte))])
+    # the covariances' columns weigh covariance_weight=0.2 after the columns' scaling
+    weight = np.where(np.arange(Ftr.shape[1]) < encoder.n_features_out_, 1.0, 0.2)
     # each column centred and divided by the square root of its standard deviation
-    root = lambda F: (F - Ftr.mean(axis=0)) / np.sqrt(Ftr.std(axis=0))  # noqa: E731
+    root = lambda F: weight * (F - Ftr.mean(axis=0)) / np.sqrt(Ftr.std(axis=0))  # noqa: E731
     assert len(Ftr) <= Ftr.shape[1] / 4  # few clips: the model is solved in their span
     span = _span(root(Ftr))
     head = LogisticRegression(C=1.0, max_iter=1000).fit(root(Ftr) @ span, ytr)
@@ -81,10 +87,11 @@ def test_equals_its_steps_run_by_hand(positions):
     # column_power=1 is sklearn's StandardScaler
     standard = clone(model).set_params(column_power=1.0).fit(Xtr, ytr)
     scaler = StandardScaler().fit(Ftr)
-    span = _span(scaler.transform(Ftr))
-    head = LogisticRegression(C=1.0, max_iter=1000).fit(scaler.transform(Ftr) @ span, ytr)
+    Ztr, Zte = weight * scaler.transform(Ftr), weight * scaler.transform(Fte)
+    span = _span(Ztr)
+    head = LogisticRegression(C=1.0, max_iter=1000).fit(Ztr @ span, ytr)
     np.testing.assert_allclose(
-        standard.predict_proba(Xte), head.predict_proba(scaler.transform(Fte) @ span), atol=1e-10
+        standard.predict_proba(Xte), head.predict_proba(Zte @ span), atol=1e-10
     )
 
 
@@ -125,7 +132,13 @@ def test_split_and_class_weight_reach_their_steps():
     keep = np.flatnonzero((y != "wave") | (np.arange(len(y)) % 3 == 0))
     X, y = [X[i] for i in keep], y[keep]
     assert (y == "wave").sum() == 1 and len(y) == 7
-    params = {"max_depth": 3, "split": "two_means", "class_weight": "balanced"}
+    # (without the covariances, which have their own test)
+    params = {
+        "max_depth": 3,
+        "split": "two_means",
+        "class_weight": "balanced",
+        "covariance_weight": 0,
+    }
     model = MotionClassifier(**params).fit(X, y)
     frames = np.vstack(X)
     scaled = [(x - frames.mean(axis=0)) / frames.std(axis=0) for x in X]
