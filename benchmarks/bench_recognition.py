@@ -337,10 +337,12 @@ def per_clip_us(model, Xte, repeats):
     return 1e6 * statistics.median(batch) / len(Xte), 1e6 * single
 
 
-def recognition(name, loaded, quick, with_dtw):
+def recognition(name, loaded, quick, with_dtw, only_models=None):
     Xtr, ytr, Xte, yte, groups, kwargs = loaded
     rows = []
     for model_name, model in models(kwargs, Xtr, with_dtw).items():
+        if only_models and not any(model_name.startswith(m) for m in only_models + ["MiniRocket"]):
+            continue
         model, fit_s, chosen = timed_fit(model_name, model, Xtr, ytr, groups)
         accuracy = float(np.mean(model.predict(Xte) == yte))
         batch_us, single_us = per_clip_us(model, Xte, 1 if quick else 3)
@@ -396,6 +398,9 @@ def main():
     parser.add_argument("--dtw", action="store_true", help="add 1-NN DTW (slow on MSRC-12)")
     parser.add_argument("--study-only", action="store_true")
     parser.add_argument(
+        "--models", nargs="+", help="run only models whose names start so (and MiniRocket)"
+    )
+    parser.add_argument(
         "--candidates", nargs="+", help="study only these candidates (and the defaults)"
     )
     args = parser.parse_args()
@@ -410,7 +415,7 @@ def main():
             print(f"{name}: data not found under {SHARED_DATA}; left out")
             continue
         if not args.study_only:
-            rows += recognition(name, loaded, args.quick, args.dtw)
+            rows += recognition(name, loaded, args.quick, args.dtw, args.models)
         if not args.quick:
             study.append(defaults_study(name, loaded, args.candidates))
     notes = (
@@ -420,7 +425,7 @@ def main():
         "is the median of three; the Rockets' numba kernels are compiled before any timing."
     )
     if rows:
-        write_results("recognition", rows, notes=notes)
+        write_results("recognition" + ("_models" if args.models else ""), rows, notes=notes)
     if study:
         # rank 1 is the best CV accuracy of a set; a candidate that does not apply ranks with the
         # defaults (it is the same model there)
