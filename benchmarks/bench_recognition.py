@@ -55,7 +55,10 @@ from skmotion.tree import MotionTreeEncoder, MotionTreeHMM  # noqa: E402
 
 PEER_FRAMES = 32
 STUDY = {  # candidate -> MotionClassifier parameters (the defaults are the first)
-    "defaults (depth 6, residuals 1 3, means 1 2 4, column_power 0.5, C 1, velocity weight 1)": {},
+    "defaults (depth 6, residuals 1 3, means 1 2 4, covariances 0.2, column_power 0.5, C 1)": {},
+    "no covariances (covariance_weight 0)": {"covariance_weight": 0.0},
+    "covariance_weight 0.3": {"covariance_weight": 0.3},
+    "covariance_weight 1": {"covariance_weight": 1.0},
     "standardised columns (column_power 1), C 0.1": {"column_power": 1.0, "C": 0.1},
     "columns in their units (column_power 0)": {"column_power": 0.0},
     "column_power 0.25": {"column_power": 0.25},
@@ -334,10 +337,12 @@ def per_clip_us(model, Xte, repeats):
     return 1e6 * statistics.median(batch) / len(Xte), 1e6 * single
 
 
-def recognition(name, loaded, quick, with_dtw):
+def recognition(name, loaded, quick, with_dtw, only_models=None):
     Xtr, ytr, Xte, yte, groups, kwargs = loaded
     rows = []
     for model_name, model in models(kwargs, Xtr, with_dtw).items():
+        if only_models and not any(model_name.startswith(m) for m in only_models + ["MiniRocket"]):
+            continue
         model, fit_s, chosen = timed_fit(model_name, model, Xtr, ytr, groups)
         accuracy = float(np.mean(model.predict(Xte) == yte))
         batch_us, single_us = per_clip_us(model, Xte, 1 if quick else 3)
@@ -361,10 +366,12 @@ def recognition(name, loaded, quick, with_dtw):
     return rows
 
 
-def defaults_study(name, loaded):
+def defaults_study(name, loaded, candidates=None):
     Xtr, ytr, _, _, groups, kwargs = loaded
     row = {"set": name}
     for candidate, params in STUDY.items():
+        if candidates and candidate != next(iter(STUDY)) and candidate not in candidates:
+            continue
         if "scaling" in params and not kwargs and not hasattr(Xtr[0], "skeleton"):
             row[candidate] = float("nan")  # no marker blocks: the same as the defaults
             continue
@@ -390,6 +397,12 @@ def main():
     parser.add_argument("--only", nargs="+", help="sets' names (or their first words)")
     parser.add_argument("--dtw", action="store_true", help="add 1-NN DTW (slow on MSRC-12)")
     parser.add_argument("--study-only", action="store_true")
+    parser.add_argument(
+        "--models", nargs="+", help="run only models whose names start so (and MiniRocket)"
+    )
+    parser.add_argument(
+        "--candidates", nargs="+", help="study only these candidates (and the defaults)"
+    )
     args = parser.parse_args()
     rows, study = [], []
     if not args.study_only:
@@ -402,9 +415,9 @@ def main():
             print(f"{name}: data not found under {SHARED_DATA}; left out")
             continue
         if not args.study_only:
-            rows += recognition(name, loaded, args.quick, args.dtw)
+            rows += recognition(name, loaded, args.quick, args.dtw, args.models)
         if not args.quick:
-            study.append(defaults_study(name, loaded))
+            study.append(defaults_study(name, loaded, args.candidates))
     notes = (
         "Peers on body-frame, size-normalised marker positions resampled to "
         f"min({PEER_FRAMES}, median training length) frames; MotionClassifier on the clips as "
@@ -412,16 +425,19 @@ def main():
         "is the median of three; the Rockets' numba kernels are compiled before any timing."
     )
     if rows:
-        write_results("recognition", rows, notes=notes)
+        write_results("recognition" + ("_models" if args.models else ""), rows, notes=notes)
     if study:
         # rank 1 is the best CV accuracy of a set; a candidate that does not apply ranks with the
         # defaults (it is the same model there)
+        names = [c for c in STUDY if c in study[0]]  # --candidates: the ones studied
+        defaults = next(iter(STUDY))
         ranks = [
-            rankdata([-(row[c] if np.isfinite(row[c]) else row[next(iter(STUDY))]) for c in STUDY])
+            rankdata([-(row[c] if np.isfinite(row[c]) else row[defaults]) for c in names])
             for row in study
         ]
-        study.append({"set": "mean rank (1 best)", **dict(zip(STUDY, np.mean(ranks, axis=0)))})
-        write_results("recognition_defaults", study, notes="3-fold CV on the training part only.")
+        study.append({"set": "mean rank (1 best)", **dict(zip(names, np.mean(ranks, axis=0)))})
+        results = "recognition_defaults" + ("_candidates" if args.candidates else "")
+        write_results(results, study, notes="3-fold CV on the training part only.")
 
 
 if __name__ == "__main__":

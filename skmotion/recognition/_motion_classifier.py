@@ -21,7 +21,7 @@ from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._progress import say
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
 
-__all__ = ["MotionClassifier", "block_scales"]
+__all__ = ["MotionClassifier", "block_scales", "clip_covariances"]
 
 # Fewer clips than this share of the columns: the linear model is solved in their span.
 _SPAN_SHARE = 0.25
@@ -64,6 +64,39 @@ def block_scales(frames, blocks, weights):
         spread = np.sqrt(np.mean(np.square(deviation[:, columns]))) if columns.any() else 0.0
         scale[columns] = (spread if spread > 0 else 1.0) / weight
     return scale
+
+
+def clip_covariances(clips):
+    """The covariance of each clip's channels over its frames: the upper triangle, row by row.
+
+    Which channels move together, and how much, whatever the order of the
+    poses: the second moments beside the vocabulary's first (the channel
+    means). A clip of one frame has covariance zero.
+
+    Parameters
+    ----------
+    clips : list of ndarray of shape (n_frames_i, n_channels)
+
+    Returns
+    -------
+    covariances : ndarray of shape (n_clips, n_channels * (n_channels + 1) // 2)
+        Entry ``(j, k)``, ``j <= k``, of each clip's covariance (divided by its
+        number of frames).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> clip = np.array([[0.0, 0.0], [2.0, 1.0], [4.0, 2.0]])
+    >>> clip_covariances([clip]).round(3).tolist()
+    [[2.667, 1.333, 0.667]]
+    """
+    n_channels = clips[0].shape[1]
+    rows, cols = np.triu_indices(n_channels)
+    covariances = np.empty((len(clips), len(rows)))
+    for i, clip in enumerate(clips):  # one BLAS product per clip
+        centred = clip - clip.mean(axis=0)
+        covariances[i] = (centred.T @ centred)[rows, cols] / len(clip)
+    return covariances
 
 
 def fit_in_span(model, columns, y):
@@ -130,7 +163,9 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
        scaled frames: every clip becomes the occupancy of every tree layer over a
        (1, 2, 3) temporal pyramid, the residuals of two layers, and each
        channel's mean over the clip, its halves and its quarters (a coarse
-       trajectory) with its root mean square;
+       trajectory) with its root mean square; and the covariance of the
+       channels over the clip (:func:`clip_covariances`: which channels move
+       together), its columns weighted by ``covariance_weight``;
     4. **classifier** -- each column centred and divided by the square root of
        its spread (``column_power``), then a multinomial logistic regression
        (``C``, ``class_weight``), whose probabilities are the answer of
@@ -175,6 +210,10 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         The tree layers whose residuals are encoded.
     moment_pyramid : array-like of int, default=(1, 2, 4)
         The parts of the clip over which each channel's mean is taken.
+    covariance_weight : float, default=0.2
+        The weight of the channels' covariance over each clip beside the
+        vocabulary (its columns scaled like the others, then times this
+        weight); 0 leaves it out.
     column_power : float, default=0.5
         Each vocabulary column is divided by its standard deviation to this
         power before the linear model: 1 standardises the columns, 0 keeps
@@ -242,6 +281,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         "split": TREE_CONSTRAINTS["split"],
         "residual_layers": ["array-like"],
         "moment_pyramid": ["array-like"],
+        "covariance_weight": [Interval(Real, 0, None, closed="left")],
         "column_power": [Interval(Real, 0, 1, closed="both")],
         "C": [Interval(Real, 0, None, closed="neither")],
         "class_weight": [StrOptions({"balanced"}), dict, None],
@@ -263,6 +303,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         split="median",
         residual_layers=(1, 3),
         moment_pyramid=(1, 2, 4),
+        covariance_weight=0.2,
         column_power=0.5,
         C=1.0,
         class_weight=None,
@@ -279,6 +320,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         self.split = split
         self.residual_layers = residual_layers
         self.moment_pyramid = moment_pyramid
+        self.covariance_weight = covariance_weight
         self.column_power = column_power
         self.C = C
         self.class_weight = class_weight
@@ -338,11 +380,13 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             standardize=False,
             sparse_output=False,
         ).fit(scaled)
-        features = self.encoder_.transform(scaled)
+        features = self._vocabulary(scaled)
         # StandardScaler's mean and spread (a constant column gets spread 1), to a power
         columns = StandardScaler().fit(features)
         self.column_center_ = columns.mean_
         self.column_scale_ = columns.scale_**self.column_power
+        if self.covariance_weight > 0:
+            self.column_scale_[self.encoder_.n_features_out_ :] /= self.covariance_weight
         say(self.verbose, f"MotionClassifier: the classifier on {features.shape[1]} columns")
         # With fewer clips than columns (sets of tens of clips), the same optimum in
         # the clips' span costs a third of the time (fit_in_span)
@@ -390,8 +434,13 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         -------
         features : ndarray of shape (n_clips, n_features)
         """
-        clips = self._clips(X)
-        return self._columns(self.encoder_.transform(clips))
+        return self._columns(self._vocabulary(self._clips(X)))
+
+    def _vocabulary(self, clips):
+        features = self.encoder_.transform(clips)
+        if self.covariance_weight > 0:
+            features = np.hstack([features, clip_covariances(clips)])
+        return features
 
     def _columns(self, features):
         return (features - self.column_center_) / self.column_scale_

@@ -15,7 +15,7 @@ from sklearn.preprocessing import StandardScaler
 
 from skmotion.datasets import make_motions, make_position_motions
 from skmotion.preprocessing import FlattenClips, ResampleClips, VirtualMarkerTransform
-from skmotion.recognition import MotionClassifier, block_scales
+from skmotion.recognition import MotionClassifier, block_scales, clip_covariances
 from skmotion.recognition._motion_classifier import fit_in_span
 from skmotion.tree import MotionTreeEncoder
 from tests.clip_conformance import ClipCase, parametrize_with_clip_checks
@@ -69,9 +69,15 @@ def test_equals_its_steps_run_by_hand(positions):
     encoder = MotionTreeEncoder(
         max_depth=4, layers="all", moment_pyramid=(1, 2, 4), standardize=False, sparse_output=False
     ).fit(S(Mtr))
-    Ftr, Fte = encoder.transform(S(Mtr)), encoder.transform(S(Mte))
+    # the vocabulary, then each clip's channel covariances (np.cov's upper triangle)
+    upper = np.triu_indices(len(scale))
+    cov = lambda M: [np.cov(m, rowvar=False, bias=True)[upper] for m in M]  # noqa: E731
+    Ftr = np.hstack([encoder.transform(S(Mtr)), cov(S(Mtr))])
+    Fte = np.hstack([encoder.transform(S(Mte)), cov(S(Mte))])
+    # the covariances' columns weigh covariance_weight=0.2 after the columns' scaling
+    weight = np.where(np.arange(Ftr.shape[1]) < encoder.n_features_out_, 1.0, 0.2)
     # each column centred and divided by the square root of its standard deviation
-    root = lambda F: (F - Ftr.mean(axis=0)) / np.sqrt(Ftr.std(axis=0))  # noqa: E731
+    root = lambda F: weight * (F - Ftr.mean(axis=0)) / np.sqrt(Ftr.std(axis=0))  # noqa: E731
     assert len(Ftr) <= Ftr.shape[1] / 4  # few clips: the model is solved in their span
     span = _span(root(Ftr))
     head = LogisticRegression(C=1.0, max_iter=1000).fit(root(Ftr) @ span, ytr)
@@ -81,10 +87,11 @@ def test_equals_its_steps_run_by_hand(positions):
     # column_power=1 is sklearn's StandardScaler
     standard = clone(model).set_params(column_power=1.0).fit(Xtr, ytr)
     scaler = StandardScaler().fit(Ftr)
-    span = _span(scaler.transform(Ftr))
-    head = LogisticRegression(C=1.0, max_iter=1000).fit(scaler.transform(Ftr) @ span, ytr)
+    Ztr, Zte = weight * scaler.transform(Ftr), weight * scaler.transform(Fte)
+    span = _span(Ztr)
+    head = LogisticRegression(C=1.0, max_iter=1000).fit(Ztr @ span, ytr)
     np.testing.assert_allclose(
-        standard.predict_proba(Xte), head.predict_proba(scaler.transform(Fte) @ span), atol=1e-10
+        standard.predict_proba(Xte), head.predict_proba(Zte @ span), atol=1e-10
     )
 
 
@@ -125,7 +132,13 @@ def test_split_and_class_weight_reach_their_steps():
     keep = np.flatnonzero((y != "wave") | (np.arange(len(y)) % 3 == 0))
     X, y = [X[i] for i in keep], y[keep]
     assert (y == "wave").sum() == 1 and len(y) == 7
-    params = {"max_depth": 3, "split": "two_means", "class_weight": "balanced"}
+    # (without the covariances, which have their own test)
+    params = {
+        "max_depth": 3,
+        "split": "two_means",
+        "class_weight": "balanced",
+        "covariance_weight": 0,
+    }
     model = MotionClassifier(**params).fit(X, y)
     frames = np.vstack(X)
     scaled = [(x - frames.mean(axis=0)) / frames.std(axis=0) for x in X]
@@ -220,6 +233,7 @@ def test_plain_channels_are_standardised_one_by_one():
         ({"scaling": "per-channel"}, "scaling"),
         ({"split": "mean"}, "split"),
         ({"class_weight": "even"}, "class_weight"),
+        ({"covariance_weight": -1.0}, "covariance_weight"),
     ],
 )
 def test_bad_parameters_are_named(params, match):
@@ -270,3 +284,46 @@ def test_msrc12_cross_subject(shared_data):
         pick(train), data.gesture[train]
     )
     assert model.score(pick(~train), data.gesture[~train]) >= 0.9
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.lists(st.integers(1, 30), min_size=1, max_size=5), st.integers(1, 6))
+def test_clip_covariances_are_numpys_covariance(lengths, n_channels):
+    """Each row is the upper triangle of ``np.cov(bias=True)`` of its clip (0 for one frame)."""
+    rng = np.random.default_rng(len(lengths) * 7 + n_channels)
+    clips = [rng.normal(size=(n, n_channels)) * rng.uniform(0.1, 5, n_channels) for n in lengths]
+    rows, cols = np.triu_indices(n_channels)
+    expected = np.zeros((len(clips), len(rows)))
+    for i, clip in enumerate(clips):
+        if len(clip) > 1:
+            expected[i] = np.atleast_2d(np.cov(clip, rowvar=False, bias=True))[rows, cols]
+    np.testing.assert_allclose(clip_covariances(clips), expected, atol=1e-12)
+
+
+def test_covariance_weight_appends_the_weighted_covariances():
+    """``covariance_weight`` appends each clip's channel covariances, scaled like the
+    vocabulary's columns and multiplied by the weight, before the linear model."""
+    X, y = small_clips()
+    model = MotionClassifier(max_depth=3, covariance_weight=0.5).fit(X, y)
+    frames = np.vstack(X)
+    scaled = [(x - frames.mean(axis=0)) / frames.std(axis=0) for x in X]
+    encoder = MotionTreeEncoder(
+        max_depth=3, layers="all", moment_pyramid=(1, 2, 4), standardize=False, sparse_output=False
+    ).fit(scaled)
+    vocabulary = encoder.transform(scaled)
+    covariances = np.array(
+        [np.cov(s, rowvar=False, bias=True)[np.triu_indices(s.shape[1])] for s in scaled]
+    )
+    root = lambda F: (F - F.mean(axis=0)) / np.sqrt(np.where(F.std(axis=0) > 0, F.std(axis=0), 1.0))  # noqa: E731
+    columns = np.hstack([root(vocabulary), 0.5 * root(covariances)])
+    np.testing.assert_allclose(model.transform(X), columns, atol=1e-10)
+    span = _span(columns)
+    head = LogisticRegression(C=1.0, max_iter=1000).fit(columns @ span, y)
+    np.testing.assert_allclose(
+        model.predict_proba(X), head.predict_proba(columns @ span), atol=1e-10
+    )
+    # weight 0 leaves the covariances out
+    assert (
+        clone(model).set_params(covariance_weight=0.0).fit(X, y).transform(X).shape[1]
+        == vocabulary.shape[1]
+    )
