@@ -99,9 +99,9 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         ``(0, 2)`` teaches a score that rises as the motion completes, not
         before (a window ending before the action point holds an unfinished
         motion, and may be drawn as a negative).
-    n_negatives : int, default=40
+    n_negatives : int, default=80
         Windows ending away from action points drawn per training take.
-    negative_gap : int, default=3
+    negative_gap : int, default=1
         A negative window ends more than this many frames from every positive
         window's end.
     none_label : str, default="none"
@@ -145,14 +145,14 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     >>> points = np.arange(49, 400, 70)                  # a repetition completes at 49, 119, ...
     >>> for end in points:                               # a rise over 20 frames, then a drop
     ...     take[end - 19 : end + 1] += np.linspace(0, 1, 20)[:, None]
-    >>> detector = LinearGestureDetector(segment=4, random_state=0)
+    >>> detector = LinearGestureDetector(random_state=0)
     >>> detector = detector.fit([take], ["rise"], action_points=[points])
     >>> # trigger="fall": a few frames after each completion, as the score drops
     >>> [event.frame for event in detector.detect([take])[0]]
-    [54, 124, 194, 264, 334]
+    [51, 121, 191, 262, 332]
     >>> stream = detector.stream()                       # the same, one frame at a time
     >>> [event.frame for frame in take for event in stream.update(frame)]
-    [54, 124, 194, 264, 334]
+    [51, 121, 191, 262, 332]
     """
 
     _parameter_constraints = {
@@ -186,8 +186,8 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         refractory=15,
         trigger="fall",
         jitter=1,
-        n_negatives=40,
-        negative_gap=3,
+        n_negatives=80,
+        negative_gap=1,
         none_label="none",
         random_state=None,
     ):

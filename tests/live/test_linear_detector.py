@@ -88,9 +88,7 @@ def test_frame_features_and_window_scores_equal_a_brute_force_reference(fitted, 
     np.testing.assert_allclose(fitted._features(take), features, rtol=1e-12, atol=1e-12)
     width = features.shape[1]
     means = segment_means(features, ends[:3], fitted.n_segments, fitted.segment)
-    np.testing.assert_allclose(
-        means[1, :width], features[ends[1] - 11 : ends[1] - 8].mean(axis=0)
-    )
+    np.testing.assert_allclose(means[1, :width], features[ends[1] - 11 : ends[1] - 8].mean(axis=0))
 
 
 def test_events_at_the_planted_ends(fitted, skeleton_takes):
