@@ -411,8 +411,11 @@ class LinearDetectorStream:
 
     def __init__(self, detector):
         d = detector
+        n_features = d.weights_.shape[1]
+        # per feature, its rows for every segment side by side: the kernel's contiguous loop
+        rows = np.ascontiguousarray(d.weights_.transpose(1, 0, 2).reshape(n_features, -1))
         self._args = (
-            d.weights_, d.bias_, *d._joints(), d.poses_, d.pose_width_, d.segment, d.none_index_
+            rows, d.bias_, *d._joints(), d.poses_, d.pose_width_, d.segment, d.none_index_
         )  # fmt: skip
         self._classes, self._none = d.classes_, d.none_index_
         self._rule = dict(threshold=d.threshold, refractory=d.refractory, trigger=d.trigger)

@@ -111,15 +111,17 @@ def frame_features(const double[:, ::1] frames, Py_ssize_t root, Py_ssize_t size
 
 cdef Py_ssize_t _window_scores(const double[:, ::1] frames, double[::1] previous,
                                double[::1] feature, double[:, :, ::1] ring, Py_ssize_t seen,
-                               const double[:, :, ::1] weights, const double[::1] bias,
+                               const double[:, ::1] weights, const double[::1] bias,
                                Py_ssize_t root, Py_ssize_t size_a, Py_ssize_t size_b,
                                const double[:, ::1] poses, double width,
                                Py_ssize_t segment, Py_ssize_t none_index, double[:, ::1] proba,
                                double[::1] score, Py_ssize_t[::1] best) noexcept nogil:
-    cdef Py_ssize_t n = frames.shape[0], m = frames.shape[1], n_seg = weights.shape[0]
-    cdef Py_ssize_t n_feat = weights.shape[1], n_cls = weights.shape[2]
+    cdef Py_ssize_t n = frames.shape[0], m = frames.shape[1], n_seg = ring.shape[1]
+    cdef Py_ssize_t n_feat = weights.shape[0], n_cls = ring.shape[2], n_rows = n_seg * n_cls
     cdef Py_ssize_t window = ring.shape[0], t, i, k, j, f, c, slot, s
     cdef double v, top, total, w
+    cdef double *row
+    cdef const double *weight
     cdef const double *reference = _rows(poses)
     for t in range(n):
         for c in range(m):
@@ -129,14 +131,16 @@ cdef Py_ssize_t _window_scores(const double[:, ::1] frames, double[::1] previous
         _features(&frames[t, 0], m, root, size_a, size_b, &previous[0], s == 0, reference,
                   poses.shape[0], width, &feature[0])
         slot = s % window
-        for k in range(n_seg):
-            for c in range(n_cls):
-                ring[slot, k, c] = 0.0
-            for f in range(n_feat):
-                v = feature[f]
-                if v != 0.0:
-                    for c in range(n_cls):
-                        ring[slot, k, c] += v * weights[k, f, c]
+        # the frame's rows for every segment, side by side: one contiguous loop per feature
+        row = &ring[slot, 0, 0]
+        for j in range(n_rows):
+            row[j] = 0.0
+        for f in range(n_feat):
+            v = feature[f]
+            if v != 0.0:
+                weight = &weights[f, 0]
+                for j in range(n_rows):
+                    row[j] += v * weight[j]
         if s < window - 1:
             score[t] = -1.0
             best[t] = -1
@@ -169,7 +173,7 @@ cdef Py_ssize_t _window_scores(const double[:, ::1] frames, double[::1] previous
 
 
 def window_scores(const double[:, ::1] frames, double[::1] previous, double[::1] feature,
-                  double[:, :, ::1] ring, Py_ssize_t seen, const double[:, :, ::1] weights,
+                  double[:, :, ::1] ring, Py_ssize_t seen, const double[:, ::1] weights,
                   const double[::1] bias, Py_ssize_t root, Py_ssize_t size_a, Py_ssize_t size_b,
                   const double[:, ::1] poses, double width, Py_ssize_t segment,
                   Py_ssize_t none_index, double[:, ::1] proba, double[::1] score,
@@ -178,7 +182,8 @@ def window_scores(const double[:, ::1] frames, double[::1] previous, double[::1]
 
     ``ring`` (window, n_segments, n_classes) holds each of the last window's
     frames' rows, ``previous`` the last normalised pose, ``feature`` is
-    scratch. Row ``t`` of ``proba`` gets the softmax of the window ending at
+    scratch. ``weights`` (n_frame_features, n_segments * n_classes): row ``f``
+    holds feature ``f``'s weights for segment 0's classes, then segment 1's, ... Row ``t`` of ``proba`` gets the softmax of the window ending at
     that frame, ``score[t]`` the best probability apart from ``none_index``
     and ``best[t]`` its class; a frame before the first full window gets
     ``score = -1`` (``proba`` untouched). ``poses`` and ``width``: as for
