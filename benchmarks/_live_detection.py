@@ -301,9 +301,11 @@ def figure(detectors, take, points, gesture, path):
         )
         ax.set_ylim(0, 1.05)
         ax.set_ylabel("probability")
-        ax.set_title(f"{name} (trigger {detector.trigger!r})", fontsize=9)
+        short = name.split(" (")[0]  # the detector, without its description
+        ax.set_title(f"{short} (trigger {detector.trigger!r})", fontsize=9)
     ax.set_xlabel("time (s)")
-    np.atleast_1d(axes)[0].legend(loc="upper right", fontsize=7, ncol=3)
+    # below the last axes: a legend inside would hide the events near the top
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.45), fontsize=7, ncol=5)
     fig.tight_layout()
     path.parent.mkdir(exist_ok=True)
     fig.savefig(path, dpi=100)
