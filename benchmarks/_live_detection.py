@@ -274,7 +274,8 @@ def figure(detectors, take, points, gesture, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(len(detectors), 1, figsize=(9, 2.1 * len(detectors)), sharex=True)
+    height = 2.1 * len(detectors) + 0.4  # and a strip for the legend below the axes
+    fig, axes = plt.subplots(len(detectors), 1, figsize=(9, height), sharex=True)
     for ax, (name, detector) in zip(np.atleast_1d(axes), detectors.items()):
         ((ends, proba),) = detector.scores([take])
         score = np.delete(proba, detector.none_index_, axis=1).max(axis=1)
@@ -304,9 +305,9 @@ def figure(detectors, take, points, gesture, path):
         short = name.split(" (")[0]  # the detector, without its description
         ax.set_title(f"{short} (trigger {detector.trigger!r})", fontsize=9)
     ax.set_xlabel("time (s)")
-    # below the last axes: a legend inside would hide the events near the top
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.45), fontsize=7, ncol=5)
-    fig.tight_layout()
+    # below the axes: a legend inside would hide the events near the top
+    fig.legend(*ax.get_legend_handles_labels(), loc="lower center", fontsize=7, ncol=5)
+    fig.tight_layout(rect=(0, 0.35 / height, 1, 1))
     path.parent.mkdir(exist_ok=True)
     fig.savefig(path, dpi=100)
     plt.close(fig)

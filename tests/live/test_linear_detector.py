@@ -235,10 +235,11 @@ def test_msrc12_two_gestures_are_detected_near_their_action_points():
         return [s for s, m in zip(seq, mask) if m]
 
     # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre
-    detector = LinearGestureDetector(root=0, size_joints=(0, 2), threshold=0.7, random_state=0)
+    # threshold 0.45: the one benchmarks/bench_live.py chose by CV over the training people
+    detector = LinearGestureDetector(root=0, size_joints=(0, 2), threshold=0.45, random_state=0)
     detector.fit(pick(takes, train), labels[train], action_points=pick(points, train))
     events = detector.detect(pick(takes, ~train))
     names = [np.full(len(p), g, dtype=object) for p, g in zip(pick(points, ~train), labels[~train])]
-    # measured 0.647 (two gestures, four training people; "lift arms" is this detector's
-    # weakest gesture on MSRC-12); events at random frames score near 0
-    assert detection_f1(pick(points, ~train), names, events, latency=8) >= 0.55
+    # measured 0.760 (two gestures, four training people; 0.647 before the reference poses,
+    # with threshold 0.7); events at random frames score near 0
+    assert detection_f1(pick(points, ~train), names, events, latency=8) >= 0.65
