@@ -32,10 +32,11 @@ LABELLING_FIGURE = FIGURE.with_name("live_labelling.png")
 LATENCIES = (0.2, 0.5, 1.0)  # seconds after (and before) an action point
 THRESHOLDS = np.r_[np.round(np.linspace(0.05, 0.95, 19), 2), 0.97, 0.99]
 REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
-# LinearGestureDetector's settings, chosen with the event rule by the same GroupKFold: segments
-# of 4 frames (a 1.3 s window; 3 and 6 frames and 4 segments of 4 gave less out-of-fold F1 on
-# half the training takes) and the regularisation C
-LINEAR_GRID = ({"segment": 4, "C": 0.1}, {"segment": 4, "C": 0.03}, {"segment": 4, "C": 0.01})
+# LinearGestureDetector's settings, chosen with the event rule by the same GroupKFold: its
+# defaults (segments of 4 frames, 64 reference poses, C=0.01) and a weaker regularisation; in
+# benchmarks/study_live_linear_settings.py (out-of-fold F1 at 0.5 s on half the training
+# takes) 0 / 64 / 128 poses gave 0.645 / 0.729 / 0.715, C 0.003 and 0.001 without poses no gain
+LINEAR_GRID = ({"C": 0.01}, {"C": 0.03})
 GESTURES = (
     "lift arms", "duck", "push right", "goggles", "wind it up", "shoot",
     "bow", "throw", "had enough", "change weapon", "beat both", "kick",
@@ -168,7 +169,10 @@ def _cost_per_frame(detector, take, rounds=3):
     )
 
 
-LINEAR = "skmotion: LinearGestureDetector (segment means of hip-centred frames, compiled)"
+LINEAR = (
+    "skmotion: LinearGestureDetector (segment means of hip-centred frames and their soft "
+    "assignment to 64 poses, compiled)"
+)
 
 
 def detectors(step, window, chosen=None):
@@ -182,18 +186,10 @@ def detectors(step, window, chosen=None):
         )
         for name, recogniser in recognisers().items()
     }
-    # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size)
-    # negatives: 80 windows per take ending anywhere more than one frame from a positive
-    # end (action point +- 1), so that the score peaks at the completion, not before or after
-    found[LINEAR] = LinearGestureDetector(
-        n_segments=5,
-        segment=window // 5,
-        root=0,
-        size_joints=(0, 2),
-        n_negatives=80,
-        negative_gap=1,
-        random_state=0,
-    )
+    # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size); the rest
+    # are the detector's defaults (80 negatives per take ending anywhere more than one frame
+    # from a positive end: action point +- 1, so that the score peaks at the completion)
+    found[LINEAR] = LinearGestureDetector(root=0, size_joints=(0, 2), random_state=0)
     if chosen:
         found = {k: v for k, v in found.items() if any(c.lower() in k.lower() for c in chosen)}
     return found
@@ -278,7 +274,8 @@ def figure(detectors, take, points, gesture, path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, axes = plt.subplots(len(detectors), 1, figsize=(9, 2.1 * len(detectors)), sharex=True)
+    height = 2.1 * len(detectors) + 0.4  # and a strip for the legend below the axes
+    fig, axes = plt.subplots(len(detectors), 1, figsize=(9, height), sharex=True)
     for ax, (name, detector) in zip(np.atleast_1d(axes), detectors.items()):
         ((ends, proba),) = detector.scores([take])
         score = np.delete(proba, detector.none_index_, axis=1).max(axis=1)
@@ -305,10 +302,12 @@ def figure(detectors, take, points, gesture, path):
         )
         ax.set_ylim(0, 1.05)
         ax.set_ylabel("probability")
-        ax.set_title(f"{name} (trigger {detector.trigger!r})", fontsize=9)
+        short = name.split(" (")[0]  # the detector, without its description
+        ax.set_title(f"{short} (trigger {detector.trigger!r})", fontsize=9)
     ax.set_xlabel("time (s)")
-    np.atleast_1d(axes)[0].legend(loc="upper right", fontsize=7, ncol=3)
-    fig.tight_layout()
+    # below the axes: a legend inside would hide the events near the top
+    fig.legend(*ax.get_legend_handles_labels(), loc="lower center", fontsize=7, ncol=5)
+    fig.tight_layout(rect=(0, 0.35 / height, 1, 1))
     path.parent.mkdir(exist_ok=True)
     fig.savefig(path, dpi=100)
     plt.close(fig)

@@ -638,7 +638,7 @@ def main():
     msrc_note = (
         "MSRC-12, odd people train, even people test; trigger, threshold and refractory period by "
         "GroupKFold(3) over the training people (out-of-fold F1 at 0.5 s). Detection: window "
-        "30 frames (2 s), step 2 (the linear detector: every frame, its segment length and C "
+        "30 frames (2 s), step 2 (the linear detector: every frame, its C "
         "by the same CV); labelling: window 60 frames (4 s), step 5, the recogniser and the "
         "switch penalty by the same CV. F1: one event "
         "per repetition, extra events false; '+-': an event "

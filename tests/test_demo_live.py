@@ -21,7 +21,7 @@ def test_live_section(tmp_path):
     if (SHARED_DATA / "msrc12").is_dir():  # gestures detected in real takes, frame by frame
         (line,) = [x for x in lines if x.startswith("MSRC-12 (")]
         f1 = float(line.split("detection F1 at 0.5 s: ")[1].split(";")[0])
-        assert f1 >= 0.6  # measured 0.73 (three gestures, six training people)
+        assert f1 >= 0.6  # measured 0.79 (three gestures, six training people)
         assert (tmp_path / "msrc12_detection.png").stat().st_size > 0
     else:
         assert "MSRC-12 not found" in text

@@ -4,6 +4,7 @@ from numbers import Integral, Real
 
 import numpy as np
 from sklearn.base import BaseEstimator
+from sklearn.cluster import KMeans
 from sklearn.linear_model import LogisticRegression
 from sklearn.preprocessing import StandardScaler
 from sklearn.utils import check_random_state
@@ -52,8 +53,12 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     points (and ``jitter`` frames around them) against windows ending
     elsewhere. A frame feature is the frame's joints relative to the ``root``
     joint, divided by the distance between the two ``size_joints`` (the
-    body's size; people and their distance to the sensor differ), and the
-    change of that from the previous frame.
+    body's size; people and their distance to the sensor differ), the
+    change of that from the previous frame, and its soft assignment to
+    ``n_poses`` reference poses (k-means centres of the training frames'
+    poses): a segment's mean of those says which poses it holds, which its
+    mean pose alone does not (two different motions can pass through the
+    same average).
 
     Because the readout is linear in the segment means, a window's score is a
     sum over its frames of one weight row per frame and segment: each new
@@ -68,15 +73,18 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     ----------
     n_segments : int, default=5
         Segments per window.
-    segment : int, default=6
-        Frames per segment (the window: ``n_segments * segment`` frames, 2 s at 15 frames/s).
+    segment : int, default=4
+        Frames per segment (the window: ``n_segments * segment`` frames, 1.3 s at 15 frames/s).
+    n_poses : int, default=64
+        Reference poses of the soft assignment (k-means on at most
+        ``20,000`` training frames' poses); 0: none.
     root : int, default=None
         The joint whose position is subtracted from every joint (channels
         ``3 * root`` to ``3 * root + 2``); None: channels as they are.
         Needs channels in joint order, three per joint.
     size_joints : (int, int), default=None
         Two joints whose distance divides the positions; None: no division.
-    C : float, default=0.1
+    C : float, default=0.01
         Inverse regularisation of the logistic regression (on standardised segment means).
     threshold : float, default=0.5
         The probability of the best motion that starts (``"rise"``) or whose
@@ -91,23 +99,29 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         ``(0, 2)`` teaches a score that rises as the motion completes, not
         before (a window ending before the action point holds an unfinished
         motion, and may be drawn as a negative).
-    n_negatives : int, default=40
+    n_negatives : int, default=80
         Windows ending away from action points drawn per training take.
-    negative_gap : int, default=3
+    negative_gap : int, default=1
         A negative window ends more than this many frames from every positive
         window's end.
     none_label : str, default="none"
         The rejection class.
     random_state : int, RandomState instance or None, default=None
-        Draws the negative windows.
+        Draws the negative windows and seeds the k-means of the reference poses.
 
     Attributes
     ----------
     classifier_ : LogisticRegression
         The readout, on standardised segment means.
-    mean_, scale_ : ndarray of shape (n_segments * 2 * n_features_in_,)
-        The standardisation of the segment means.
-    weights_ : ndarray of shape (n_segments, 2 * n_features_in_, n_classes)
+    poses_ : ndarray of shape (n_poses, n_features_in_)
+        The reference poses (root-centred, size-normalised).
+    pose_width_ : float
+        The squared distance scaling the soft assignment: the median squared
+        distance of a training frame to its nearest reference pose.
+    mean_, scale_ : ndarray of shape (n_segments * n_frame_features,)
+        The standardisation of the segment means (``n_frame_features =
+        2 * n_features_in_ + n_poses``).
+    weights_ : ndarray of shape (n_segments, n_frame_features, n_classes)
         The readout per frame and segment: a frame feature times
         ``weights_[k]`` is that frame's part of the decision when it lies in segment ``k``.
     bias_ : ndarray of shape (n_classes,)
@@ -131,19 +145,20 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     >>> points = np.arange(49, 400, 70)                  # a repetition completes at 49, 119, ...
     >>> for end in points:                               # a rise over 20 frames, then a drop
     ...     take[end - 19 : end + 1] += np.linspace(0, 1, 20)[:, None]
-    >>> detector = LinearGestureDetector(segment=4, random_state=0)
+    >>> detector = LinearGestureDetector(random_state=0)
     >>> detector = detector.fit([take], ["rise"], action_points=[points])
     >>> # trigger="fall": a few frames after each completion, as the score drops
     >>> [event.frame for event in detector.detect([take])[0]]
-    [54, 124, 194, 264, 334]
+    [51, 121, 191, 262, 332]
     >>> stream = detector.stream()                       # the same, one frame at a time
     >>> [event.frame for frame in take for event in stream.update(frame)]
-    [54, 124, 194, 264, 334]
+    [51, 121, 191, 262, 332]
     """
 
     _parameter_constraints = {
         "n_segments": [Interval(Integral, 1, None, closed="left")],
         "segment": [Interval(Integral, 1, None, closed="left")],
+        "n_poses": [Interval(Integral, 0, None, closed="left")],
         "root": [Interval(Integral, 0, None, closed="left"), None],
         "size_joints": [tuple, list, None],
         "C": [Interval(Real, 0, None, closed="neither")],
@@ -162,21 +177,23 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self,
         *,
         n_segments=5,
-        segment=6,
+        segment=4,
+        n_poses=64,
         root=None,
         size_joints=None,
-        C=0.1,
+        C=0.01,
         threshold=0.5,
         refractory=15,
         trigger="fall",
         jitter=1,
-        n_negatives=40,
-        negative_gap=3,
+        n_negatives=80,
+        negative_gap=1,
         none_label="none",
         random_state=None,
     ):
         self.n_segments = n_segments
         self.segment = segment
+        self.n_poses = n_poses
         self.root = root
         self.size_joints = size_joints
         self.C = C
@@ -226,7 +243,27 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         return pair
 
     def _features(self, take):
-        return frame_features(np.ascontiguousarray(take, dtype=float), *self._joints())
+        take = np.ascontiguousarray(take, dtype=float)
+        return frame_features(take, *self._joints(), self.poses_, self.pose_width_)
+
+    def _fit_poses(self, clips, rng):
+        """``poses_`` and ``pose_width_``: k-means of the training frames' normalised poses."""
+        width = self.n_features_in_
+        self.poses_, self.pose_width_ = np.zeros((0, width)), 1.0
+        if self.n_poses == 0:
+            return
+        poses = np.vstack([self._features(c)[:, :width] for c in clips])
+        poses = poses[:: -(-len(poses) // 20000)]  # at most 20,000 frames: k-means stays quick
+        if len(np.unique(poses, axis=0)) < self.n_poses:
+            raise ValueError(
+                f"n_poses={self.n_poses}: the training takes hold fewer distinct frames "
+                f"({len(np.unique(poses, axis=0))}); lower n_poses."
+            )
+        kmeans = KMeans(self.n_poses, n_init=1, random_state=rng.integers(2**31)).fit(poses)
+        nearest = kmeans.transform(poses).min(axis=1) ** 2
+        width = float(np.median(nearest))
+        self.poses_ = np.ascontiguousarray(kmeans.cluster_centers_)
+        self.pose_width_ = width if width > 0 else 1.0
 
     @_fit_context(prefer_skip_nested_validation=False)
     def fit(self, X, y, *, action_points=None):
@@ -256,6 +293,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         moved = [np.clip(p[:, None] + shifts, 0, len(c) - 1).ravel() for p, c in zip(points, clips)]
         moved_labels = [np.repeat(n, len(shifts)) for n in labels]
         rng = np.random.default_rng(check_random_state(self.random_state).randint(2**31))
+        self._fit_poses(clips, rng)
         ends, targets = training_ends(
             clips,
             moved,
@@ -295,7 +333,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
             coef, intercept = np.vstack([np.zeros_like(coef), coef]), np.r_[0.0, intercept]
         coef = coef / self.scale_
         self.bias_ = intercept - coef @ self.mean_
-        n_features = 2 * self.n_features_in_
+        n_features = 2 * self.n_features_in_ + len(self.poses_)
         self.weights_ = np.ascontiguousarray(
             (coef / self.segment).T.reshape(self.n_segments, n_features, len(self.classes_))
         )
@@ -373,7 +411,12 @@ class LinearDetectorStream:
 
     def __init__(self, detector):
         d = detector
-        self._args = (d.weights_, d.bias_, *d._joints(), d.segment, d.none_index_)
+        n_features = d.weights_.shape[1]
+        # per feature, its rows for every segment side by side: the kernel's contiguous loop
+        rows = np.ascontiguousarray(d.weights_.transpose(1, 0, 2).reshape(n_features, -1))
+        self._args = (
+            rows, d.bias_, *d._joints(), d.poses_, d.pose_width_, d.segment, d.none_index_
+        )  # fmt: skip
         self._classes, self._none = d.classes_, d.none_index_
         self._rule = dict(threshold=d.threshold, refractory=d.refractory, trigger=d.trigger)
         self._threshold, self._fall = d.threshold, d.trigger == "fall"
@@ -381,7 +424,7 @@ class LinearDetectorStream:
         n_classes = len(d.classes_)
         self._ring = np.zeros((d.window, d.n_segments, n_classes))
         self._previous = np.zeros(d.n_features_in_)
-        self._feature = np.zeros(2 * d.n_features_in_)
+        self._feature = np.zeros(d.weights_.shape[1])
         self._one = (np.zeros((1, n_classes)), np.zeros(1), np.zeros(1, dtype=np.intp))
         self.last_proba = self._one[0][0]
         self.reset()

@@ -21,13 +21,46 @@ the previous frame (a velocity; zero at a stream's first frame).
 
 import numpy as np
 
-from libc.math cimport exp, isfinite, sqrt
+from libc.math cimport INFINITY, exp, isfinite, sqrt
+
+
+cdef inline void _soft_poses(const double *pose, Py_ssize_t n_channels, const double *poses,
+                             Py_ssize_t n_poses, double width, double *out) noexcept nogil:
+    """``out[j]``: the soft assignment of ``pose`` to reference pose ``j`` (they sum to 1);
+    ``poses`` holds ``n_poses`` rows of ``n_channels``."""
+    cdef Py_ssize_t j, c
+    cdef double d, e, nearest = INFINITY, total = 0.0
+    for j in range(n_poses):
+        d = 0.0
+        for c in range(n_channels):
+            e = pose[c] - poses[j * n_channels + c]
+            d += e * e
+        out[j] = d
+        if d < nearest:
+            nearest = d
+    for j in range(n_poses):
+        # a term below exp(-36) (2e-16) of the nearest pose's is under the rounding of the
+        # sum: zero, rather than a subnormal number that slows every product it enters
+        # (and a zero feature is skipped by the window update)
+        e = (out[j] - nearest) / width
+        out[j] = exp(-e) if e < 36.0 else 0.0
+        total += out[j]
+    for j in range(n_poses):
+        out[j] /= total
+
+
+cdef inline const double *_rows(const double[:, ::1] poses) noexcept nogil:
+    """The first row of ``poses``, or NULL when it has none (never read then)."""
+    return &poses[0, 0] if poses.shape[0] > 0 else NULL
 
 
 cdef inline void _features(const double *x, Py_ssize_t n_channels, Py_ssize_t root,
                            Py_ssize_t size_a, Py_ssize_t size_b, double *previous,
-                           bint first, double *out) noexcept nogil:
-    """``out[:n_channels]`` the normalised pose, ``out[n_channels:]`` its change; updates ``previous``."""
+                           bint first, const double *poses, Py_ssize_t n_poses,
+                           double width, double *out) noexcept nogil:
+    """``out[:n_channels]`` the normalised pose, ``out[n_channels:2 n_channels]`` its change,
+    ``out[2 n_channels:]`` its soft assignment to the ``n_poses`` rows of ``poses``;
+    updates ``previous``."""
     cdef Py_ssize_t c
     cdef double size = 1.0, d, q
     cdef double r[3]
@@ -51,46 +84,63 @@ cdef inline void _features(const double *x, Py_ssize_t n_channels, Py_ssize_t ro
         out[c] = q
         out[n_channels + c] = 0.0 if first else q - previous[c]
         previous[c] = q
+    if n_poses > 0:
+        _soft_poses(out, n_channels, poses, n_poses, width, out + 2 * n_channels)
 
 
 def frame_features(const double[:, ::1] frames, Py_ssize_t root, Py_ssize_t size_a,
-                   Py_ssize_t size_b):
-    """The features of every frame of a take (its first frame's velocity is zero)."""
+                   Py_ssize_t size_b, const double[:, ::1] poses, double width):
+    """The features of every frame of a take (its first frame's velocity is zero).
+
+    ``poses`` (n_poses, n_channels): the reference poses (zero rows: none), ``width``
+    the squared distance that scales the soft assignment.
+    """
     cdef Py_ssize_t n = frames.shape[0], m = frames.shape[1], t
-    out = np.empty((n, 2 * m))
+    if poses.shape[0] and poses.shape[1] != m:
+        raise ValueError(f"poses have {poses.shape[1]} channels, the frames {m}.")
+    out = np.empty((n, 2 * m + poses.shape[0]))
     cdef double[:, ::1] o = out
     cdef double[::1] previous = np.zeros(m)
+    cdef const double *reference = _rows(poses)
     with nogil:
         for t in range(n):
-            _features(&frames[t, 0], m, root, size_a, size_b, &previous[0], t == 0, &o[t, 0])
+            _features(&frames[t, 0], m, root, size_a, size_b, &previous[0], t == 0, reference,
+                      poses.shape[0], width, &o[t, 0])
     return out
 
 
 cdef Py_ssize_t _window_scores(const double[:, ::1] frames, double[::1] previous,
                                double[::1] feature, double[:, :, ::1] ring, Py_ssize_t seen,
-                               const double[:, :, ::1] weights, const double[::1] bias,
+                               const double[:, ::1] weights, const double[::1] bias,
                                Py_ssize_t root, Py_ssize_t size_a, Py_ssize_t size_b,
+                               const double[:, ::1] poses, double width,
                                Py_ssize_t segment, Py_ssize_t none_index, double[:, ::1] proba,
                                double[::1] score, Py_ssize_t[::1] best) noexcept nogil:
-    cdef Py_ssize_t n = frames.shape[0], m = frames.shape[1], n_seg = weights.shape[0]
-    cdef Py_ssize_t n_feat = weights.shape[1], n_cls = weights.shape[2]
+    cdef Py_ssize_t n = frames.shape[0], m = frames.shape[1], n_seg = ring.shape[1]
+    cdef Py_ssize_t n_feat = weights.shape[0], n_cls = ring.shape[2], n_rows = n_seg * n_cls
     cdef Py_ssize_t window = ring.shape[0], t, i, k, j, f, c, slot, s
     cdef double v, top, total, w
+    cdef double *row
+    cdef const double *weight
+    cdef const double *reference = _rows(poses)
     for t in range(n):
         for c in range(m):
             if not isfinite(frames[t, c]):
                 return t
         s = seen + t
-        _features(&frames[t, 0], m, root, size_a, size_b, &previous[0], s == 0, &feature[0])
+        _features(&frames[t, 0], m, root, size_a, size_b, &previous[0], s == 0, reference,
+                  poses.shape[0], width, &feature[0])
         slot = s % window
-        for k in range(n_seg):
-            for c in range(n_cls):
-                ring[slot, k, c] = 0.0
-            for f in range(n_feat):
-                v = feature[f]
-                if v != 0.0:
-                    for c in range(n_cls):
-                        ring[slot, k, c] += v * weights[k, f, c]
+        # the frame's rows for every segment, side by side: one contiguous loop per feature
+        row = &ring[slot, 0, 0]
+        for j in range(n_rows):
+            row[j] = 0.0
+        for f in range(n_feat):
+            v = feature[f]
+            if v != 0.0:
+                weight = &weights[f, 0]
+                for j in range(n_rows):
+                    row[j] += v * weight[j]
         if s < window - 1:
             score[t] = -1.0
             best[t] = -1
@@ -123,20 +173,23 @@ cdef Py_ssize_t _window_scores(const double[:, ::1] frames, double[::1] previous
 
 
 def window_scores(const double[:, ::1] frames, double[::1] previous, double[::1] feature,
-                  double[:, :, ::1] ring, Py_ssize_t seen, const double[:, :, ::1] weights,
+                  double[:, :, ::1] ring, Py_ssize_t seen, const double[:, ::1] weights,
                   const double[::1] bias, Py_ssize_t root, Py_ssize_t size_a, Py_ssize_t size_b,
-                  Py_ssize_t segment, Py_ssize_t none_index, double[:, ::1] proba,
-                  double[::1] score, Py_ssize_t[::1] best):
+                  const double[:, ::1] poses, double width, Py_ssize_t segment,
+                  Py_ssize_t none_index, double[:, ::1] proba, double[::1] score,
+                  Py_ssize_t[::1] best):
     """Feed ``frames`` to a stream that has seen ``seen`` frames; one score row per frame.
 
     ``ring`` (window, n_segments, n_classes) holds each of the last window's
     frames' rows, ``previous`` the last normalised pose, ``feature`` is
-    scratch. Row ``t`` of ``proba`` gets the softmax of the window ending at
+    scratch. ``weights`` (n_frame_features, n_segments * n_classes): row ``f``
+    holds feature ``f``'s weights for segment 0's classes, then segment 1's, ... Row ``t`` of ``proba`` gets the softmax of the window ending at
     that frame, ``score[t]`` the best probability apart from ``none_index``
     and ``best[t]`` its class; a frame before the first full window gets
-    ``score = -1`` (``proba`` untouched). Returns the index of the first frame
-    holding NaN or infinity (the frames before it are taken), or -1.
+    ``score = -1`` (``proba`` untouched). ``poses`` and ``width``: as for
+    :func:`frame_features`. Returns the index of the first frame holding NaN or
+    infinity (the frames before it are taken), or -1.
     """
     # the GIL is kept: a call is a frame or a take of a few microseconds of work per frame
     return _window_scores(frames, previous, feature, ring, seen, weights, bias, root, size_a,
-                          size_b, segment, none_index, proba, score, best)
+                          size_b, poses, width, segment, none_index, proba, score, best)

@@ -5,6 +5,8 @@ import sys
 
 import numpy as np
 import pytest
+from scipy.spatial.distance import cdist
+from scipy.special import softmax
 from sklearn.base import clone
 
 from skmotion.estimator_checks import ClipCase, parametrize_with_clip_checks
@@ -16,18 +18,22 @@ from tests.conftest import SHARED_DATA
 from tests.live.test_detector import motion_clips, planted_take
 
 
-def brute_force_features(take, root, size_a, size_b):
-    """Frame features the slow way: joints minus the root, over the body size, and the change."""
+def brute_force_features(take, root, size_a, size_b, poses, width):
+    """Frame features the slow way: joints minus the root, over the body size, the change,
+    and the softmax of minus the squared distances to ``poses`` over ``width``."""
     joints = take.reshape(len(take), -1, 3)
     size = np.linalg.norm(joints[:, size_a] - joints[:, size_b], axis=1)
     pose = ((joints - joints[:, root : root + 1]) / size[:, None, None]).reshape(len(take), -1)
     change = np.vstack([np.zeros((1, pose.shape[1])), np.diff(pose, axis=0)])
-    return np.hstack([pose, change])
+    soft = softmax(-cdist(pose, poses, "sqeuclidean") / width, axis=1)
+    return np.hstack([pose, change, soft])
 
 
 def brute_force_proba(detector, take):
     """Each window's probabilities: its segment means by explicit slices, then the classifier."""
-    features = brute_force_features(take, 0, *detector.size_joints)
+    features = brute_force_features(
+        take, 0, *detector.size_joints, detector.poses_, detector.pose_width_
+    )
     w, s = detector.window, detector.segment
     rows = []
     for end in range(w - 1, len(take)):
@@ -63,9 +69,12 @@ def skeleton_takes():
 @pytest.fixture(scope="module")
 def fitted(skeleton_takes):
     takes, points, labels = skeleton_takes
+    # a toy of 4 joints and two motions: 8 reference poses (64 split its few poses finely
+    # enough to learn the training takes' noise: F1 0.42 on the held-out takes)
     detector = LinearGestureDetector(
-        n_segments=4, segment=3, root=0, size_joints=(0, 1), refractory=10, random_state=0
-    )
+        n_segments=4, segment=3, n_poses=8, root=0, size_joints=(0, 1), refractory=10,
+        random_state=0,
+    )  # fmt: skip
     return detector.fit(takes[:4], labels[:4], action_points=points[:4])
 
 
@@ -75,10 +84,11 @@ def test_frame_features_and_window_scores_equal_a_brute_force_reference(fitted, 
     np.testing.assert_array_equal(ends, np.arange(fitted.window - 1, len(take)))
     np.testing.assert_allclose(proba, brute_force_proba(fitted, take), rtol=1e-9, atol=1e-12)
     # the training features go through the same segment means
-    features = brute_force_features(take, 0, 0, 1)
+    features = brute_force_features(take, 0, 0, 1, fitted.poses_, fitted.pose_width_)
     np.testing.assert_allclose(fitted._features(take), features, rtol=1e-12, atol=1e-12)
+    width = features.shape[1]
     means = segment_means(features, ends[:3], fitted.n_segments, fitted.segment)
-    np.testing.assert_allclose(means[1, :24], features[ends[1] - 11 : ends[1] - 8].mean(axis=0))
+    np.testing.assert_allclose(means[1, :width], features[ends[1] - 11 : ends[1] - 8].mean(axis=0))
 
 
 def test_events_at_the_planted_ends(fitted, skeleton_takes):
@@ -225,10 +235,11 @@ def test_msrc12_two_gestures_are_detected_near_their_action_points():
         return [s for s, m in zip(seq, mask) if m]
 
     # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre
-    detector = LinearGestureDetector(root=0, size_joints=(0, 2), threshold=0.7, random_state=0)
+    # threshold 0.45: the one benchmarks/bench_live.py chose by CV over the training people
+    detector = LinearGestureDetector(root=0, size_joints=(0, 2), threshold=0.45, random_state=0)
     detector.fit(pick(takes, train), labels[train], action_points=pick(points, train))
     events = detector.detect(pick(takes, ~train))
     names = [np.full(len(p), g, dtype=object) for p, g in zip(pick(points, ~train), labels[~train])]
-    # measured 0.647 (two gestures, four training people; "lift arms" is this detector's
-    # weakest gesture on MSRC-12); events at random frames score near 0
-    assert detection_f1(pick(points, ~train), names, events, latency=8) >= 0.55
+    # measured 0.760 (two gestures, four training people; 0.647 before the reference poses,
+    # with threshold 0.7); events at random frames score near 0
+    assert detection_f1(pick(points, ~train), names, events, latency=8) >= 0.65
