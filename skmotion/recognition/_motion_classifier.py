@@ -107,7 +107,7 @@ def fit_in_span(model, columns, y):
     representer theorem): with ``n`` rows and ``d >> n`` columns the problem is
     solved on the rows' ``n`` coordinates in an orthonormal basis of a space that
     holds them (the Q of the rows' QR factors), whose penalty is the same, and
-    the weights are mapped back. The same optimum, with ``r`` instead of ``d``
+    the weights are mapped back. The same optimum, with ``n`` instead of ``d``
     unknowns per class; with ``n > d / 4`` the basis costs more than it saves
     and the model is fitted as it is.
 
