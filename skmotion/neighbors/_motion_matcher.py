@@ -78,7 +78,6 @@ def floor_frames(points, *, root, lefts, rights, up="y"):
         Examples
         --------
         >>> import numpy as np
-    from joblib import effective_n_jobs
         >>> from skmotion.neighbors import floor_frames
         >>> # Y up: the floor's x is world z, its y world x; left hip at +x faces +z.
         >>> p = np.array([[[0.0, 1.0, 2.0], [0.1, 1.0, 2.0], [-0.1, 1.0, 2.0]]])
