@@ -58,32 +58,32 @@ EF_DEFAULT = 24
 def floor_frames(points, *, root, lefts, rights, up="y"):
     """Where the body frame is on the floor and where it faces, per frame.
 
-        Parameters
-        ----------
-        points : ndarray of shape (n_frames, n_points, 3)
-            World positions.
-        root, lefts, rights : sequence of int
-            The root points (averaged) and the facing pairs, as for
-            :func:`~skmotion.preprocessing.position_frame_features`.
-        up : {"x", "y", "z"}, default="y"
+    Parameters
+    ----------
+    points : ndarray of shape (n_frames, n_points, 3)
+        World positions.
+    root, lefts, rights : sequence of int
+        The root points (averaged) and the facing pairs, as for
+        :func:`~skmotion.preprocessing.position_frame_features`.
+    up : {"x", "y", "z"}, default="y"
 
-        Returns
-        -------
-        origin : ndarray of shape (n_frames, 2)
-            The root below on the floor, in the planner's floor axes
-            (:func:`~skmotion.planning.plan_axes`).
-        yaw : ndarray of shape (n_frames,)
-            The facing direction, counter-clockwise from the floor's ``x`` axis.
+    Returns
+    -------
+    origin : ndarray of shape (n_frames, 2)
+        The root below on the floor, in the planner's floor axes
+        (:func:`~skmotion.planning.plan_axes`).
+    yaw : ndarray of shape (n_frames,)
+        The facing direction, counter-clockwise from the floor's ``x`` axis.
 
-        Examples
-        --------
-        >>> import numpy as np
-        >>> from skmotion.neighbors import floor_frames
-        >>> # Y up: the floor's x is world z, its y world x; left hip at +x faces +z.
-        >>> p = np.array([[[0.0, 1.0, 2.0], [0.1, 1.0, 2.0], [-0.1, 1.0, 2.0]]])
-        >>> origin, yaw = floor_frames(p, root=[0], lefts=[1], rights=[2])
-        >>> origin.tolist(), yaw.round(6).tolist()
-        ([[2.0, 0.0]], [0.0])
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.neighbors import floor_frames
+    >>> # Y up: the floor's x is world z, its y world x; left hip at +x faces +z.
+    >>> p = np.array([[[0.0, 1.0, 2.0], [0.1, 1.0, 2.0], [-0.1, 1.0, 2.0]]])
+    >>> origin, yaw = floor_frames(p, root=[0], lefts=[1], rights=[2])
+    >>> origin.tolist(), yaw.round(6).tolist()
+    ([[2.0, 0.0]], [0.0])
     """
     plan = points @ plan_axes(up)
     origin = plan[:, list(root), :2].mean(axis=1)
