@@ -29,7 +29,6 @@ import math
 from numbers import Integral, Real
 
 import numpy as np
-from joblib import effective_n_jobs
 from sklearn.base import BaseEstimator
 from sklearn.neighbors import BallTree, KDTree
 from sklearn.utils.validation import check_is_fitted
@@ -131,17 +130,12 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         Weights of the groups (after each is divided by its spread).
     algorithm : {"auto", "kd_tree", "ball_tree", "brute", "hnsw"}, default="auto"
         ``"auto"`` is the exact ``"kd_tree"``; ``"hnsw"`` is approximate:
-        faiss's HNSW graph (the ``ann`` extra, ``faiss-cpu``) of degree 32.
+        faiss's HNSW graph (the ``ann`` extra, ``faiss-cpu``) of degree 32,
+        built on one thread so that it is the same graph every time.
     leaf_size : int, default=40
         Leaf size of the trees.
     ef : int, default=24
         HNSW search beam: larger is slower and more often exact.
-    n_jobs : int, default=None
-        Threads that build the HNSW graph (queries run on one). None or 1:
-        one thread, the same graph every time. More threads build it faster,
-        but the graph may then depend on the threads' timing, and so, rarely,
-        may an approximate answer. -1: every core.
-        The exact backends ignore it.
 
     Attributes
     ----------
@@ -184,7 +178,6 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         "algorithm": [StrOptions({"auto", "kd_tree", "ball_tree", "brute", "hnsw"})],
         "leaf_size": [Interval(Integral, 1, None, closed="left")],
         "ef": [Interval(Integral, 1, None, closed="left")],
-        "n_jobs": [Integral, None],
     }
 
     def __init__(
@@ -200,7 +193,6 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         algorithm="auto",
         leaf_size=40,
         ef=EF_DEFAULT,
-        n_jobs=None,
     ):
         self.layout = layout
         self.points = points
@@ -212,7 +204,6 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         self.algorithm = algorithm
         self.leaf_size = leaf_size
         self.ef = ef
-        self.n_jobs = n_jobs
 
     def _take_points(self, take, i):
         """World points (metres), the role indices, the up axis and the frame rate of a take."""
@@ -311,7 +302,7 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         elif algorithm == "ball_tree":
             self.index_ = BallTree(data, leaf_size=self.leaf_size)
         elif algorithm == "hnsw":
-            self.index_ = _hnsw_index(data, self.n_jobs)
+            self.index_ = _hnsw_index(data)
             self._ef_set = None
         else:
             self.index_ = None
@@ -438,13 +429,18 @@ def _faiss():
     return faiss
 
 
-def _hnsw_index(data, n_jobs):
-    """faiss's HNSW graph of the rows, built on ``n_jobs`` threads (None: one, the same graph)."""
+def _hnsw_index(data, threads=1):
+    """faiss's HNSW graph of the rows, by default on one thread: the same graph every time.
+
+    More threads build it faster, but the graph may then depend on their timing
+    (the benchmark uses two to save time; it is not an estimator parameter, as
+    skmotion's ``n_jobs`` promises results identical to one job's).
+    """
     faiss = _faiss()
     index = faiss.IndexHNSWFlat(data.shape[1], HNSW_M)
     index.hnsw.efConstruction = HNSW_EF_CONSTRUCTION
     threads = faiss.omp_get_max_threads()
-    faiss.omp_set_num_threads(effective_n_jobs(n_jobs))
+    faiss.omp_set_num_threads(threads)
     try:
         index.add(np.ascontiguousarray(data, dtype=np.float32))
     finally:

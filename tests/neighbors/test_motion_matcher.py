@@ -125,8 +125,8 @@ def test_hnsw_recall_and_pickle(walks):
     )
 
 
-@pytest.mark.parametrize("n_jobs", [None, 2])
-def test_hnsw_graph_recall_on_a_made_up_cloud(n_jobs):
+@pytest.mark.parametrize("threads", [1, 2])
+def test_hnsw_graph_recall_on_a_made_up_cloud(threads):
     # MotionMatcher's graph (its degree, construction beam and search) on 5,000 points
     # of a noisy 10-dimensional plane in 30 dimensions, against brute force. The beam
     # matters here: one entry finds the nearest point for about 60 % of the queries.
@@ -138,7 +138,7 @@ def test_hnsw_graph_recall_on_a_made_up_cloud(n_jobs):
     cloud += 0.05 * rng.normal(size=cloud.shape)
     data, queries = cloud[:5000], cloud[5000:]
     truth = np.sqrt(((queries[:, None] - data[None]) ** 2).sum(axis=2).min(axis=1))
-    index = _hnsw_index(data, n_jobs)
+    index = _hnsw_index(data, threads)
     recall = {}
     for ef in (1, EF_DEFAULT):
         index.hnsw.efSearch = ef
@@ -229,6 +229,7 @@ _NOT_CLIPS = "the takes are Motions with a skeleton, not channel arrays"
                 "check_set_output_pandas": "not a transformer",
                 "check_cross_val_score": "no score: a search structure",
                 "check_grid_search": "no score: a search structure",
+                "check_n_jobs": "no n_jobs",
             },
         )
     ]
