@@ -125,6 +125,29 @@ def test_hnsw_recall_and_pickle(walks):
     )
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_hnsw_graph_recall_on_a_made_up_cloud(threads):
+    # MotionMatcher's graph (its degree, construction beam and search) on 5,000 points
+    # of a noisy 10-dimensional plane in 30 dimensions, against brute force. The beam
+    # matters here: one entry finds the nearest point for about 60 % of the queries.
+    pytest.importorskip("faiss")
+    from skmotion.neighbors._motion_matcher import EF_DEFAULT, _faiss_search, _hnsw_index
+
+    rng = np.random.default_rng(0)
+    cloud = rng.normal(size=(5500, 10)) @ rng.normal(size=(10, 30))
+    cloud += 0.05 * rng.normal(size=cloud.shape)
+    data, queries = cloud[:5000], cloud[5000:]
+    truth = np.sqrt(((queries[:, None] - data[None]) ** 2).sum(axis=2).min(axis=1))
+    index = _hnsw_index(data, threads)
+    recall = {}
+    for ef in (1, EF_DEFAULT):
+        index.hnsw.efSearch = ef
+        found = _faiss_search(index, queries, 1)[0][:, 0]
+        recall[ef] = np.mean(np.isclose(found, truth, rtol=1e-4))
+    assert recall[1] < 0.8
+    assert recall[EF_DEFAULT] >= 0.99
+
+
 def test_hnsw_follows_ef_changes_after_fit(walks):
     pytest.importorskip("faiss")
     takes, new = walks
