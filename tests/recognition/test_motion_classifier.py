@@ -188,6 +188,10 @@ def test_probabilities_and_decisions_agree(positions):
     assert (model.classes_[proba.argmax(axis=1)] == model.predict(Xte)).all()
     assert (model.decision_function(Xte).argmax(axis=1) == proba.argmax(axis=1)).all()
     np.testing.assert_allclose(np.exp(model.predict_log_proba(Xte)), proba)
+    # predicting folds the columns' scaling into the weights: the same as classifier_ on
+    # the scaled columns that transform returns
+    direct = model.classifier_.decision_function(model.transform(Xte))
+    np.testing.assert_allclose(model.decision_function(Xte), direct, rtol=1e-9, atol=1e-9)
 
 
 def test_novelty_ranks_foreign_clips_lower(positions):
