@@ -139,7 +139,7 @@ def fit_in_span(model, columns, y):
     if n_samples > _SPAN_SHARE * n_features:
         return model.fit(columns, y)
     # Any orthonormal basis of a space holding the rows will do (the optimum lies in
-    # it): the QR factors of the rows costs half the time of their singular vectors
+    # it): the rows' QR factors cost half the time of their singular vectors
     basis, _ = np.linalg.qr(columns.T)
     model.fit(columns @ basis, y)
     model.coef_ = model.coef_ @ basis.T
@@ -394,12 +394,14 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
             standardize=False,
             sparse_output=False,
         ).fit(scaled)
+        # fitted state, so that a later set_params does not change what transform computes
+        self._with_covariances = self.covariance_weight > 0
         features = self._vocabulary(scaled)
         # StandardScaler's mean and spread (a constant column gets spread 1), to a power
         columns = StandardScaler().fit(features)
         self.column_center_ = columns.mean_
         self.column_scale_ = columns.scale_**self.column_power
-        if self.covariance_weight > 0:
+        if self._with_covariances:
             self.column_scale_[self.encoder_.n_features_out_ :] /= self.covariance_weight
         say(self.verbose, f"MotionClassifier: the classifier on {features.shape[1]} columns")
         # With fewer clips than columns (sets of tens of clips), the same optimum in
@@ -457,7 +459,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
 
     def _vocabulary(self, clips):
         features = self.encoder_.transform(clips)
-        if self.covariance_weight > 0:
+        if self._with_covariances:
             features = np.hstack([features, clip_covariances(clips)])
         return features
 
