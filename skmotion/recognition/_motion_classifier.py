@@ -451,7 +451,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         -------
         features : ndarray of shape (n_clips, n_features)
         """
-        return self._columns(self._vocabulary(self._clips(X)))
+        return self._columns(self._raw(X))
 
     def _raw(self, X):
         """The vocabulary before the columns' scaling (``_readout`` has it folded in)."""
