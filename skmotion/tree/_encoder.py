@@ -25,9 +25,8 @@ from skmotion.tree._encoding._histograms import (
     residual_features,
     second_order_features,
 )
-from skmotion.tree._encoding._readout_passes import extremes_within
 from skmotion.tree._encoding._routing import TreeRouter
-from skmotion.tree._magnitude import check_magnitude, check_stacked_magnitude, overflow_limit
+from skmotion.tree._magnitude import check_magnitude, check_stacked_magnitude
 from skmotion.tree._motion_tree import MotionTree
 from skmotion.utils._clips import check_clips, stack_clips
 from skmotion.utils._features import channel_names_in
@@ -333,16 +332,11 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
         else:
             frames, offsets = stack_clips(clips)
         frames = np.asarray(frames, dtype=np.float64)  # float32 clips: converted once, here
-        routed, residual_columns, centers, scales = self._transform_plan()
-        # the raw values, then in training spreads: every channel's extremes over all frames
-        # against both limits in one compiled pass; only when they fail, each clip's (the
-        # error names the first clip and channel past a limit)
-        if not extremes_within(frames, centers, scales, overflow_limit([frames])):
-            checks = [
-                (0.0, 1.0, None),
-                (self.moment_center_, self.moment_scale_, _SPREADS_OVERFLOW),
-            ]
-            check_stacked_magnitude(frames, offsets, self, checks)
+        routed, residual_columns = self._transform_plan()
+        # the raw values, then in training spreads (one compiled pass over all frames for
+        # both; each clip's only when it fails, to name the clip and channel)
+        checks = [(0.0, 1.0, None), (self.moment_center_, self.moment_scale_, _SPREADS_OVERFLOW)]
+        check_stacked_magnitude(frames, offsets, self, checks)
         sparse = self._sparse()
         if sparse and self._output_config() == "pandas":
             raise ValueError(
@@ -402,18 +396,15 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     def _transform_plan(self):
         """What transform works out once per fit (on its first call, as on one clip its
         making is felt): the layers routed (increasing), the residual layers' columns among
-        them, and the centres and scales of the two magnitude checks (raw values, values in
-        training spreads), one row each."""
+        them."""
         plan = self.__dict__.get("_plan")
-        if plan is None or len(plan) != 5 or plan[0] is not self.tree_:  # or an older plan
+        if plan is None or len(plan) != 3 or plan[0] is not self.tree_:  # or an older plan
             layer_sets = (self.layers_, self.transition_layers_, self.residual_layers_)
             routed = np.array(sorted({int(v) for layers in layer_sets for v in layers}), np.intp)
             columns = np.searchsorted(routed, self.residual_layers_)
             if len(columns) and (np.diff(columns) == 1).all():  # a view of the nodes, no copy
                 columns = slice(int(columns[0]), int(columns[-1]) + 1)
-            centers = np.stack([np.zeros(self.n_features_in_), self.moment_center_])
-            scales = np.stack([np.ones(self.n_features_in_), self.moment_scale_])
-            plan = (self.tree_, routed, columns, centers, scales)
+            plan = (self.tree_, routed, columns)
             self._plan = plan
         return plan[1:]
 
