@@ -106,11 +106,17 @@ def fit_in_span(model, columns, y):
     The gradient of the loss and of the L2 penalty with respect to the weights
     is a combination of the rows, so the optimal weights are one too (the
     representer theorem): with ``n`` rows and ``d >> n`` columns the problem is
-    solved on the rows' ``n`` coordinates in an orthonormal basis of a space that
-    holds them (the Q of the rows' QR factors), whose penalty is the same, and
-    the weights are mapped back. The same optimum, with ``n`` instead of ``d``
-    unknowns per class; with ``n > d / 4`` the basis costs more than it saves
-    and the model is fitted as it is.
+    solved on the rows' ``n`` coordinates in an orthonormal basis of their span,
+    whose penalty is the same, and the weights are mapped back. The same optimum,
+    with ``n`` instead of ``d`` unknowns per class; with ``n > d / 4`` the basis
+    costs more than it saves and the model is fitted as it is.
+
+    The basis comes from the rows' ``n x n`` Gram matrix ``K = X X^T = V L V^T``:
+    ``B = X^T V L^(-1/2)`` is orthonormal and the rows' coordinates in it are
+    ``X B = V L^(1/2)``, so ``B`` itself is never formed (one matrix product over
+    the columns, against two passes for a QR factorisation: 0.05 s against 0.54 s
+    for 114 clips x 20,000 columns). Directions whose eigenvalue is within
+    rounding of zero hold no part of any row and are left out.
 
     Parameters
     ----------
@@ -138,11 +144,12 @@ def fit_in_span(model, columns, y):
     n_samples, n_features = columns.shape
     if n_samples > _SPAN_SHARE * n_features:
         return model.fit(columns, y)
-    # Any orthonormal basis of a space holding the rows will do (the optimum lies in
-    # it): the rows' QR factors cost half the time of their singular vectors
-    basis, _ = np.linalg.qr(columns.T)
-    model.fit(columns @ basis, y)
-    model.coef_ = model.coef_ @ basis.T
+    values, vectors = np.linalg.eigh(columns @ columns.T)
+    kept = values > values[-1] * n_samples * np.finfo(float).eps
+    root = np.sqrt(values[kept])
+    vectors = vectors[:, kept]
+    model.fit(vectors * root, y)
+    model.coef_ = ((model.coef_ / root) @ vectors.T) @ columns
     model.n_features_in_ = n_features
     return model
 

@@ -96,8 +96,14 @@ def test_equals_its_steps_run_by_hand(positions):
 
 
 def _span(columns):
-    """An orthonormal basis of a space holding the rows: Q of the rows' QR factors."""
-    return np.linalg.qr(columns.T)[0]
+    """An orthonormal basis of the rows' span, ``X^T V L^(-1/2)`` from the rows' Gram
+    matrix ``X X^T = V L V^T`` (the basis ``fit_in_span`` solves in: with the model's
+    default tolerance another basis ends the solver's path elsewhere)."""
+    values, vectors = np.linalg.eigh(columns @ columns.T)
+    kept = values > values[-1] * len(columns) * np.finfo(float).eps
+    basis = columns.T @ vectors[:, kept] / np.sqrt(values[kept])
+    np.testing.assert_allclose(basis.T @ basis, np.eye(kept.sum()), atol=1e-8)
+    return basis
 
 
 @pytest.mark.parametrize("n_classes", [2, 4])
