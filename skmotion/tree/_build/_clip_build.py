@@ -46,8 +46,6 @@ from skmotion.tree._gaussian import estimate_covariance
 
 __all__ = ["build_from_clips"]
 
-# Chunks of shifted_moments per block read from the clips (about 17 MB at 60 channels).
-_CHUNKS_PER_BLOCK = 64
 
 
 def build_from_clips(stacked, params):
@@ -107,7 +105,8 @@ def _stream_root(stacked, params):
         total = np.add.reduce(view if total is not None else view[1:], axis=0)
     shift = total / n  # block.mean(axis=0) of the stacked frames
     out = (np.zeros(d), np.zeros((d, d)))
-    for _, block in stacked.blocks(moment_chunk_rows(d) * _CHUNKS_PER_BLOCK):
+    chunk = moment_chunk_rows(d)  # blocks of whole chunks, about PROJECT_ROWS rows
+    for _, block in stacked.blocks(chunk * max(1, PROJECT_ROWS // chunk)):
         shifted_moments(block, shift, True, out=out)
     sums, products = out
     scatter = products - np.outer(sums, sums / n)
