@@ -14,13 +14,13 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from skmotion.tree._build._node_passes import moment_chunk_rows, shifted_moments
+from skmotion.tree._build._permute import scatter_rows
 
 import skmotion.tree._encoder as encoder_module
 from skmotion.tree import MotionTree, MotionTreeEncoder
 from skmotion.tree._build import TreeParams
 from skmotion.tree._build._clip_build import build_from_clips
-from skmotion.tree._build._node_passes import moment_chunk_rows, shifted_moments
-from skmotion.tree._build._permute import scatter_rows
 from skmotion.tree._build._standardise import (
     StackedClips,
     column_mean_std,
