@@ -168,6 +168,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     entries sum: no Python step per clip or frame. The defaults come from a
     study over several data sets (user guide, ``docs/motion-database.md``).
 
+    Memory: from 2**18 frames on (float64 clips of two channels or more),
+    ``fit`` builds the tree from the clips themselves, read and standardised a
+    block at a time, with each child of the root built in a copy of its own
+    frames: the same tree to the bit as over a stacked standardised copy of all
+    frames (what smaller fits make), in about half that copy's memory besides
+    the caller's clips (user guide, ``docs/scaling.md``).
+
     Examples
     --------
     >>> from sklearn.linear_model import LogisticRegression
