@@ -31,10 +31,10 @@ from skmotion.tree._build._node_passes import moment_chunk_rows, partition_rows,
 from skmotion.tree._build._nodes import (
     _GAP_RESOLUTION,
     PROJECT_ROWS,
-    _Builder,
     _fix_signs,
     _principal_axis,
     _top_eigenvectors,
+    build_subtree,
     cut_projections,
     kept_scatter,
     project_rows,
@@ -161,21 +161,4 @@ def _build_child(stacked, params, root, side, sibling):
     standardise_in_place(frames, stacked.center, stacked.scale)  # the same doubles
     top = {"shift": root["mean"], "kept": root["kept"], "sibling": sibling}
     depth = None if params.max_depth is None else params.max_depth - 1
-    builder = _Builder(
-        frames,
-        depth,
-        params.min_samples_split,
-        params.min_samples_leaf,
-        params.split,
-        params.covariance_type,
-        params.reg_covar,
-        copy=False,
-        top=top,
-    )
-    builder.index = None  # the copy's order need not be put back
-    builder.tol, builder.reg = root["tol"], root["reg"]  # the whole build's
-    builder.run()
-    t = builder.nodes
-    sub = {key: t[key] for key in ("parent", "depth", "mean", "cov", "axis", "thr", "left", "right")}
-    sub["count"] = [b - a for a, b in zip(t["start"], t["stop"])]
-    return sub, builder.top_result
+    return build_subtree(frames, params, depth, root["tol"], root["reg"], top)

@@ -22,7 +22,7 @@ from skmotion.tree._build._permute import permute_rows
 from skmotion.tree._build._split import best_split
 from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
 
-__all__ = ["build_nodes", "project_rows"]
+__all__ = ["build_nodes", "build_subtree", "project_rows"]
 
 # A cut must sit in a gap wider than this many units of the projections'
 # rounding error, so routing a training frame again always finds the same side.
@@ -373,6 +373,40 @@ class _Builder:
             self.index = None
             permute_rows(self.blocks, inverse)
         return layers
+
+
+def build_subtree(frames, params, max_depth, tol, reg, top=None):
+    """The subtree of one node of a larger build, built in ``frames`` (its own copy of the
+    node's frames, reordered and not put back), under the whole build's gap resolution
+    ``tol`` and regularisation ``reg`` (the out-of-core build's tasks, the lean fit's
+    children; ``top``: as for ``_Builder``).
+
+    Returns
+    -------
+    nodes : dict
+        Per subtree node (the node itself first): ``parent``, ``depth``, ``count``,
+        ``mean``, ``cov``, ``axis``, ``thr``, ``left``, ``right`` (lists).
+    top_result : dict
+        The node's own result (its products: a sibling built after it derives from them).
+    """
+    builder = _Builder(
+        frames,
+        max_depth,
+        params.min_samples_split,
+        params.min_samples_leaf,
+        params.split,
+        params.covariance_type,
+        params.reg_covar,
+        copy=False,
+        top=top,
+    )
+    builder.index = None  # the frames are the caller's copy: their order is not put back
+    builder.tol, builder.reg = tol, reg  # the whole build's, not this node's
+    builder.run()
+    t = builder.nodes
+    sub = {key: t[key] for key in ("parent", "depth", "mean", "cov", "axis", "thr", "left", "right")}
+    sub["count"] = [b - a for a, b in zip(t["start"], t["stop"])]
+    return sub, builder.top_result
 
 
 def build_nodes(
