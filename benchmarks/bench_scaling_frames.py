@@ -21,7 +21,8 @@ so making them costs no more than the array). Sizes 10^5, 10^6, 3x10^6 and 10^7
 (``--sizes`` to choose; ``--quick``: 10^4 and 10^5). ``--peers-up-to N`` leaves the
 sklearn fits out above N frames (they take minutes there). ``--before SRC`` adds the
 build of the skmotion source tree SRC (for example an older checkout) on the same
-frames. The two copying builds stop at 10^6 frames (their memory figure is clear
+frames (and, with ``encoder`` or ``encoder2`` among the methods, that source's encoder
+fits). The two copying builds stop at 10^6 frames (their memory figure is clear
 there). The growth exponent of each method is the slope of log seconds against log
 frames over the sizes it ran. ``--methods`` runs some of them (``tree_in_place``,
 ``tree_threads``, ``tree``, ``encoder``, ``encoder2``, ``bisecting``, ``minibatch``).
@@ -55,6 +56,7 @@ METHODS = {
     "MiniBatchKMeans(256)": "minibatch",
 }
 PEERS = {"bisecting", "minibatch"}
+ENCODERS = {"encoder", "encoder2"}
 
 
 def make_frames(n):
@@ -145,18 +147,22 @@ def run(method, n, source=None):
 
 
 def main(sizes, peers_up_to, before=None, only=None, name="scaling_frames"):
-    methods = {k: v for k, v in METHODS.items() if only is None or v in only}
+    methods = [(k, v, None) for k, v in METHODS.items() if only is None or v in only]
     if before is not None:
-        methods[f"MotionTree.build, {Path(before).name}"] = "before"
+        # the old build, and the encoder fits of the old source on the same frames
+        methods.append((f"MotionTree.build, {Path(before).name}", "before", before))
+        methods += [
+            (f"{k}, {Path(before).name}", v, before) for k, v, _ in methods if v in ENCODERS
+        ]
     rows = []
-    for label, method in methods.items():
+    for label, method, source in methods:
         runs = []
         for n in sizes:
             if method in PEERS and n > peers_up_to:
                 continue
             if method in ("tree", "before") and n > 1_000_000:
                 continue  # the copying builds: their memory figure is clear by 10^6
-            result = run(method, n, before if method == "before" else None)
+            result = run(method, n, source)
             print(method, "skmotion from", result["skmotion"], flush=True)
             runs.append((n, result["seconds"]))
             rows.append(

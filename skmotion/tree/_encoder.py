@@ -9,7 +9,8 @@ from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipFeatureMixin, MotionTags
 from skmotion.tree._build import TREE_CONSTRAINTS, TreeParams
-from skmotion.tree._build._standardise import column_mean_std, standardise_in_place
+from skmotion.tree._build._clip_build import build_from_clips
+from skmotion.tree._build._standardise import StackedClips, column_mean_std, standardise_in_place
 from skmotion.tree._encoding._columns import (
     _existing,
     _int_list,
@@ -39,6 +40,10 @@ __all__ = ["MotionTreeEncoder"]
 _SPARSE_FROM = 1024
 # transform's second magnitude check: the moments sum squares in training spreads
 _SPREADS_OVERFLOW = "sums squares of the values in training spreads, which overflow float64"
+# fit builds the tree from the caller's clips, without a stacked standardised copy of their
+# frames, from this many frames on (float64 clips of two channels or more): the same tree to
+# the bit, in about half the memory and a few more passes over the frames (docs/scaling.md)
+_LEAN_FROM_FRAMES = 1 << 18
 
 
 class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
@@ -163,6 +168,13 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
     entries sum: no Python step per clip or frame. The defaults come from a
     study over several data sets (user guide, ``docs/motion-database.md``).
 
+    Memory: from 2**18 frames on (float64 clips of two channels or more),
+    ``fit`` builds the tree from the clips themselves, read and standardised a
+    block at a time, with each child of the root built in a copy of its own
+    frames: the same tree to the bit as over a stacked standardised copy of all
+    frames (what smaller fits make), in about half that copy's memory besides
+    the caller's clips (user guide, ``docs/scaling.md``).
+
     Examples
     --------
     >>> from sklearn.linear_model import LogisticRegression
@@ -255,16 +267,21 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             raise ValueError("moment_pyramid must name at least one level, e.g. (1,) or (1, 2, 4).")
         clips = check_clips(X, estimator=self, reset=True)
         check_magnitude(clips, self)
-        frames, _ = stack_clips(clips)
-        self.moment_center_, spread = column_mean_std(frames)  # no centred copy
+        stacked = StackedClips(clips)
+        lean = (
+            stacked.n_frames >= max(_LEAN_FROM_FRAMES, stacked.n_channels)
+            and stacked.n_channels > 1
+            and all(clip.dtype == np.float64 for clip in clips)
+        )
+        frames = None if lean else stack_clips(clips)[0]
+        # no centred copy; over the clips themselves in the lean fit (the same doubles)
+        self.moment_center_, spread = stacked.mean_std() if lean else column_mean_std(frames)
         self.moment_scale_ = np.where(spread > 0, spread, 1.0)
-        self.center_ = np.zeros(frames.shape[1])
-        self.scale_ = np.ones(frames.shape[1])
+        self.center_ = np.zeros(stacked.n_channels)
+        self.scale_ = np.ones(stacked.n_channels)
         if self.standardize:
             self.center_, self.scale_ = self.moment_center_, self.moment_scale_
-        say(self.verbose, f"MotionTreeEncoder: building the tree over {len(frames):,} frames")
-        # standardised over the stacked copy itself, and the tree built in it: no other copy
-        z = standardise_in_place(frames, self.center_, self.scale_)
+        say(self.verbose, f"MotionTreeEncoder: building the tree over {stacked.n_frames:,} frames")
         depth = build_depth(
             self.max_depth, self.layers, self.transition_layers, self.residual_layers
         )
@@ -274,7 +291,14 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             split=self.split,
             covariance_type="spherical",  # routing uses the splits only
         )
-        self.tree_ = MotionTree.from_params(z, params, copy=False)
+        stacked.center, stacked.scale = self.center_, self.scale_
+        if lean:  # the clips read a block at a time, standardised there: no stacked copy
+            self.tree_ = build_from_clips(stacked, params)
+            z_blocks = stacked.blocks
+        else:  # standardised over the stacked copy itself, and the tree built in it
+            z = standardise_in_place(frames, self.center_, self.scale_)
+            self.tree_ = MotionTree.from_params(z, params, copy=False)
+            z_blocks = _array_blocks(z)
         bottom = self.tree_.n_layers - 1
         wanted = range(1, bottom + 1) if _is_all(self.layers) else _int_list("layers", self.layers)
         self.layers_ = np.array(sorted({v for v in wanted if v <= bottom}), dtype=np.intp)
@@ -303,7 +327,7 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             # routed as transform routes them (the raw frames), a group of clips at a time:
             # no second stacked copy of the frames
             nodes = self._router.route_clips(clips, self.residual_layers_)
-            self._residual_variances = node_variances(z, nodes, self._residual_means)
+            self._residual_variances = node_variances(z_blocks, nodes, self._residual_means)
         orders = 2 if self._residual_variances else 1
         n_residual = self.tree_.n_nodes[self.residual_layers_].sum() * orders
         n_moments = (sum(moment_pyramid) + self.moments - 1) if self.moments else 0
@@ -441,3 +465,8 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             moments=self.moments,
             moment_pyramid=self._moment_pyramid,
         )
+
+
+def _array_blocks(z):
+    """``StackedClips.blocks`` of an array: its consecutive blocks of ``rows`` rows."""
+    return lambda rows: ((start, z[start : start + rows]) for start in range(0, len(z), rows))

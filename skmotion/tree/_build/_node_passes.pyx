@@ -49,7 +49,13 @@ def _load():
 _load()
 
 
-def shifted_moments(const double[:, ::1] block, const double[::1] shift, bint scatter=True):
+def moment_chunk_rows(intp d):
+    """Rows per chunk of :func:`shifted_moments` over ``d`` channels (its blocks' unit)."""
+    return max(1, _CHUNK_VALUES // max(d, 1))
+
+
+def shifted_moments(const double[:, ::1] block, const double[::1] shift, bint scatter=True,
+                    out=None):
     """Sums and scatter of rows about a shift: ``sum(x - s)`` and ``sum (x - s)(x - s)^T``.
 
     The node's mean is ``s + sums / n`` and its scatter about the mean is
@@ -64,6 +70,11 @@ def shifted_moments(const double[:, ::1] block, const double[::1] shift, bint sc
         False: only the diagonal of the products (the per-channel sums of squares),
         without the ``d x d`` product: what a node that is not split needs for a
         diagonal or spherical covariance.
+    out : tuple of (sums, products), default=None
+        Running sums and products (as returned) to add this block's to, in place: the
+        rows of one array given in consecutive blocks of a multiple of the chunk's rows
+        (``32768 // d``) add up to the doubles of the whole array in one call (the
+        chunks, and the order their sums are added in, are the same).
 
     Returns
     -------
@@ -85,7 +96,14 @@ def shifted_moments(const double[:, ::1] block, const double[::1] shift, bint sc
     if shift.shape[0] != d:
         raise ValueError(f"shift has {shift.shape[0]} values for {d} channels.")
     cdef intp chunk = max(1, _CHUNK_VALUES // max(d, 1))
-    sums_array = np.zeros(d)
+    if out is None:
+        sums_array = np.zeros(d)
+        products_array = np.zeros((d, d)) if scatter else np.zeros(d)
+    else:
+        sums_array, products_array = out
+        wanted = (int(d), int(d)) if scatter else (int(d),)
+        if tuple(sums_array.shape) != (d,) or tuple(products_array.shape) != wanted:
+            raise ValueError("out's sums and products do not match the block's channels.")
     chunk_sums_array = np.empty(d)
     cdef double[::1] sums = sums_array, chunk_sums = chunk_sums_array
     cdef double[::1] squares
@@ -95,11 +113,9 @@ def shifted_moments(const double[:, ::1] block, const double[::1] shift, bint sc
     cdef double one = 1.0
     cdef char upper = b"U", no_trans = b"N"
     if scatter:
-        products_array = np.zeros((d, d))
         products = products_array
         buffer = np.empty((chunk, d))
     else:
-        products_array = np.zeros(d)
         squares = products_array
     if n == 0 or d == 0:
         return sums_array, products_array

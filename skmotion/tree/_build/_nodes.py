@@ -22,7 +22,7 @@ from skmotion.tree._build._permute import permute_rows
 from skmotion.tree._build._split import best_split
 from skmotion.tree._gaussian import centred_moments, estimate_covariance, low_rank_covariance
 
-__all__ = ["build_nodes"]
+__all__ = ["build_nodes", "build_subtree", "project_rows"]
 
 # A cut must sit in a gap wider than this many units of the projections'
 # rounding error, so routing a training frame again always finds the same side.
@@ -38,6 +38,18 @@ _TASK_FRAMES = 1 << 16
 _KEEP_ROWS_PER_CHANNEL = 64
 _SUM_ROUNDING = 1e-13
 _DERIVED_ACCURACY = 1e-9
+# Rows projected by one matrix-vector product: a node's projections are made block by block
+# from its first row, so a build fed the same rows a block at a time (the encoder's lean fit,
+# ``_clip_build``) gets the same doubles whatever the BLAS kernel's own blocking is.
+PROJECT_ROWS = 1 << 15
+
+
+def project_rows(block, axis, out=None):
+    """``block @ axis``, in products of ``PROJECT_ROWS`` rows (into ``out`` when given)."""
+    out = np.empty(len(block)) if out is None else out
+    for start in range(0, len(block), PROJECT_ROWS):
+        np.matmul(block[start : start + PROJECT_ROWS], axis, out=out[start : start + PROJECT_ROWS])
+    return out
 
 
 def _top_eigenvectors(symmetric, k):
@@ -80,6 +92,26 @@ def _principal_axis(centred, scatter):
     return -axis if axis[np.argmax(np.abs(axis))] < 0 else axis
 
 
+def cut_projections(proj, split, min_samples_leaf, tol):
+    """Where a node's projections are cut: the frames on the left and the threshold
+    (None, nan when no cut is allowed)."""
+    ordered = np.sort(proj)
+    n_left = best_split(ordered, split, min_samples_leaf=min_samples_leaf, tol=tol)
+    if n_left is None:
+        return None, np.nan
+    # the cut sits in a gap far wider than rounding, so it separates the sides exactly
+    return n_left, 0.5 * (ordered[n_left - 1] + ordered[n_left])
+
+
+def kept_scatter(scatter, raw, n, d, covariance_type):
+    """What a split node keeps for its children's derived scatters: its scatter and an
+    error bound (None with too few rows per channel, or for a full covariance)."""
+    if n < _KEEP_ROWS_PER_CHANNEL * d or covariance_type == "full":
+        return None
+    error = 0.0 if raw is None else raw[2]
+    return scatter, error + _SUM_ROUNDING * np.trace(scatter)
+
+
 class _Builder:
     """Breadth-first construction on the frames reordered so that every node's frames
     are one contiguous block (splitting a node partitions its block in place).
@@ -88,7 +120,13 @@ class _Builder:
     order is put back after the build (``index`` follows every row). With
     ``n_jobs`` above 1 the nodes of a layer are processed in that many threads (the
     passes over the frames release the GIL); every node is computed as it would be
-    alone, so the tree does not depend on ``n_jobs``."""
+    alone, so the tree does not depend on ``n_jobs``.
+
+    ``top`` builds the subtree of a node of a larger tree alone (the encoder's lean fit,
+    ``_clip_build``): the node's parent's mean ``"shift"``, the parent's kept scatter
+    ``"kept"`` and its sibling's products ``"sibling"`` (or None), with which the node's
+    moments are the doubles the whole build gives it; ``tol`` and ``reg`` are then set by
+    the caller (the whole build's). The top node's result is kept in ``top_result``."""
 
     def __init__(
         self,
@@ -101,7 +139,10 @@ class _Builder:
         reg_covar,
         copy=True,
         n_jobs=1,
+        top=None,
     ):
+        self.top = top
+        self.top_result = None
         # Rounding of a projection x @ axis is below d * eps * max|x|; cuts must
         # sit in gaps far wider, so a training frame always routes back to its side.
         self.tol = _GAP_RESOLUTION * X.shape[1] * max(float(X.max()), -float(X.min()))
@@ -165,8 +206,13 @@ class _Builder:
             return (*centred_moments(block), None)
         n = len(block)
         parent = self.nodes["parent"][node]
-        shift = block.mean(axis=0) if parent < 0 else self.nodes["mean"][parent]
-        raw = self.derived(parent, sibling) if scatter else None
+        top = self.top if parent < 0 else None  # a subtree's top: its parent is elsewhere
+        if top is not None:
+            shift, kept, sibling = top["shift"], top["kept"], top["sibling"]
+        else:
+            shift = block.mean(axis=0) if parent < 0 else self.nodes["mean"][parent]
+            kept = self.kept.get(parent)
+        raw = self.derived(kept, sibling) if scatter else None
         if raw is None:
             raw = (*shifted_moments(block, shift, scatter), 0.0)
         sums, products, error = raw
@@ -176,14 +222,14 @@ class _Builder:
         scatter = products - np.outer(sums, sums / n)
         # the error bound of the products: a direct sum's rounding, or what the derivation's was
         raw = (sums, products, error or _SUM_ROUNDING * np.trace(products))
-        return mean, scatter, None, raw if parent >= 0 else None
+        return mean, scatter, None, raw if parent >= 0 or top is not None else None
 
-    def derived(self, parent, sibling):
+    @staticmethod
+    def derived(kept, sibling):
         """The products about the parent's mean, ``(sums, products, error)``, as the
-        parent's scatter minus the sibling's products; None when the parent's scatter
+        parent's kept scatter minus the sibling's products; None when the parent's scatter
         was not kept, or when its error bound exceeds ``_DERIVED_ACCURACY`` of the result
         (a node with far less spread than its parent: the difference would cancel)."""
-        kept = self.kept.get(parent)
         if kept is None or sibling is None or sibling.get("raw") is None:
             return None
         parent_scatter, parent_error = kept
@@ -204,7 +250,7 @@ class _Builder:
         block = self.blocks[start:stop]
         n, d = block.shape
         may_split = may_split and n >= self.min_split
-        root = nodes["parent"][node] < 0
+        root = nodes["parent"][node] < 0 and self.top is None
         mean, scatter, sq_norms, raw = self.moments(node, block, may_split or root, sibling)
         if self.reg is None:  # the root: reg_covar is relative to its mean per-channel variance
             scale = np.trace(scatter) / (n * d)
@@ -215,27 +261,31 @@ class _Builder:
         result["raw"] = raw
         if self.kind == "full" and n <= d:  # the covariance is low rank plus a floor
             result["low_rank"] = low_rank_covariance(block - mean, scatter, sq_norms, self.reg)
+        if nodes["parent"][node] < 0:
+            self.top_result = result
         if not may_split:
             return result
         axis = _principal_axis(block - mean if n < d else None, scatter)
         if axis is None:
             return result
-        proj = block @ axis  # as routing computes it
-        ordered = np.sort(proj)
-        n_left = best_split(ordered, self.split, min_samples_leaf=self.min_leaf, tol=self.tol)
+        proj = project_rows(block, axis)  # as routing computes it
+        n_left, thr = self.cut(proj)
         if n_left is None:
             return result
-        # the cut sits in a gap far wider than rounding, so it separates the sides exactly
-        thr = 0.5 * (ordered[n_left - 1] + ordered[n_left])
-        del ordered
         index = None if self.index is None else self.index[start:stop]
         if partition_rows(block, proj, thr, index) != n_left:  # pragma: no cover - a bug
             raise RuntimeError(f"node {node}: the cut does not separate {n_left} frames.")
         result.update(axis=axis, thr=thr, n_left=n_left)
-        if n >= _KEEP_ROWS_PER_CHANNEL * d and self.kind != "full":  # for a child's derivation
-            error = 0.0 if raw is None else raw[2]
-            result["keep"] = (scatter, error + _SUM_ROUNDING * np.trace(scatter))
+        kept = self.kept_scatter(scatter, raw, n, d)
+        if kept is not None:
+            result["keep"] = kept
         return result
+
+    def cut(self, proj):
+        return cut_projections(proj, self.split, self.min_leaf, self.tol)
+
+    def kept_scatter(self, scatter, raw, n, d):
+        return kept_scatter(scatter, raw, n, d, self.kind)
 
     def process_family(self, family, may_split):
         """``process`` of a node or of two siblings: the one with fewer rows first, whose
@@ -323,6 +373,40 @@ class _Builder:
             self.index = None
             permute_rows(self.blocks, inverse)
         return layers
+
+
+def build_subtree(frames, params, max_depth, tol, reg, top=None):
+    """The subtree of one node of a larger build, built in ``frames`` (its own copy of the
+    node's frames, reordered and not put back), under the whole build's gap resolution
+    ``tol`` and regularisation ``reg`` (the out-of-core build's tasks, the lean fit's
+    children; ``top``: as for ``_Builder``).
+
+    Returns
+    -------
+    nodes : dict
+        Per subtree node (the node itself first): ``parent``, ``depth``, ``count``,
+        ``mean``, ``cov``, ``axis``, ``thr``, ``left``, ``right`` (lists).
+    top_result : dict
+        The node's own result (its products: a sibling built after it derives from them).
+    """
+    builder = _Builder(
+        frames,
+        max_depth,
+        params.min_samples_split,
+        params.min_samples_leaf,
+        params.split,
+        params.covariance_type,
+        params.reg_covar,
+        copy=False,
+        top=top,
+    )
+    builder.index = None  # the frames are the caller's copy: their order is not put back
+    builder.tol, builder.reg = tol, reg  # the whole build's, not this node's
+    builder.run()
+    t = builder.nodes
+    sub = {key: t[key] for key in ("parent", "depth", "mean", "cov", "axis", "thr", "left", "right")}
+    sub["count"] = [b - a for a, b in zip(t["start"], t["stop"])]
+    return sub, builder.top_result
 
 
 def build_nodes(

@@ -38,7 +38,7 @@ import numpy as np
 from skmotion.tree._build._frame_sources import BLOCK_ROWS, chunk_sources, read_blocks
 from skmotion.tree._build._nodes import (
     _GAP_RESOLUTION,
-    _Builder,
+    build_subtree,
     _fix_signs,
     _principal_axis,
     _top_eigenvectors,
@@ -144,30 +144,10 @@ def _subtree_task(pieces, d, params, max_depth, tol, reg):
     for path, count in pieces:
         X[at : at + count] = np.fromfile(path, dtype=np.float64, count=count * d).reshape(count, d)
         at += count
-    builder = _Builder(
-        X,
-        max_depth,
-        params.min_samples_split,
-        params.min_samples_leaf,
-        params.split,
-        params.covariance_type,
-        params.reg_covar,
-        copy=False,
-    )
-    builder.tol, builder.reg = tol, reg  # the whole build's, not this node's
-    builder.run()
+    sub, _ = build_subtree(X, params, max_depth, tol, reg)
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-    nodes = builder.nodes
     return {
-        "parent": nodes["parent"],
-        "depth": nodes["depth"],
-        "count": [b - a for a, b in zip(nodes["start"], nodes["stop"])],
-        "mean": nodes["mean"],
-        "cov": nodes["cov"],
-        "axis": nodes["axis"],
-        "thr": nodes["thr"],
-        "left": nodes["left"],
-        "right": nodes["right"],
+        **sub,
         "frames_held": total,
         "peak_rss_mb": peak_mb,
         "pid": os.getpid(),

@@ -72,3 +72,41 @@ def permute_rows(double[:, ::1] block, const intp[::1] order):
                 break
     if bad:
         raise ValueError("order is not a permutation of the rows; the block is left partly moved.")
+
+
+def scatter_rows(const double[:, ::1] block, const intp[::1] place, intp low, intp high,
+                 double[:, ::1] out):
+    """Copy each row of ``block`` whose place is in ``[low, high)`` to ``out[place - low]``.
+
+    The lean fit's gather of one child's frames from consecutive blocks of the clips
+    (``_clip_build``): one compiled pass, no mask or index arrays the size of a block.
+
+    Parameters
+    ----------
+    block : ndarray of shape (n, d), C-contiguous float64
+    place : ndarray of shape (n,) of intp
+        Each row's place among all rows of the node being split.
+    low, high : int
+        The child's places.
+    out : ndarray of shape (high - low, d), C-contiguous float64, writable
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree._build._permute import scatter_rows
+    >>> out = np.zeros((2, 2))
+    >>> scatter_rows(np.arange(6.0).reshape(3, 2), np.array([3, 0, 2]), 2, 4, out)
+    >>> out.tolist()
+    [[4.0, 5.0], [0.0, 1.0]]
+    """
+    cdef intp n = block.shape[0], d = block.shape[1], r, p
+    if place.shape[0] != n or out.shape[1] != d or out.shape[0] != high - low:
+        raise ValueError("scatter_rows: block, place and out do not match.")
+    if d == 0:
+        return
+    cdef size_t row_bytes = d * sizeof(double)
+    with nogil:
+        for r in range(n):
+            p = place[r]
+            if low <= p < high:
+                memcpy(&out[p - low, 0], &block[r, 0], row_bytes)

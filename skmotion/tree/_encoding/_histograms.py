@@ -228,11 +228,13 @@ def _node_averages(values, nodes, clip_weights, k):
     return [group_sums(v, group, weight, n_groups) for v in values], share
 
 
-def node_variances(z, nodes, means):
-    """Each node's per-channel variance of the standardised frames ``z`` routed to it.
+def node_variances(z_blocks, nodes, means):
+    """Each node's per-channel variance of the standardised frames routed to it.
 
     1 where a node holds fewer than two frames; at least 1e-3 (a floor against
-    division by a node whose frames agree in a channel).
+    division by a node whose frames agree in a channel). ``z_blocks(rows)`` yields
+    ``(start, block)``, the standardised frames' consecutive blocks of ``rows`` rows
+    (``StackedClips.blocks``: no stacked copy needed).
     """
     variances = []
     for j, mean in enumerate(means):
@@ -240,9 +242,9 @@ def node_variances(z, nodes, means):
         count = np.bincount(node, minlength=len(mean))[:, None]
         squares = np.zeros_like(mean)
         # in blocks of rows (the same sums in the same order): the temporaries are a block's
-        for start in range(0, len(z), _ROWS_PER_BLOCK):
-            rows = slice(start, start + _ROWS_PER_BLOCK)
-            np.add.at(squares, node[rows], (z[rows] - mean[node[rows]]) ** 2)
+        for start, block in z_blocks(_ROWS_PER_BLOCK):
+            rows = slice(start, start + len(block))
+            np.add.at(squares, node[rows], (block - mean[node[rows]]) ** 2)
         spread = np.maximum(squares / np.maximum(count, 1), 1e-3)
         variances.append(np.where(count > 1, spread, 1.0))
     return variances
