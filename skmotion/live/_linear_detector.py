@@ -91,8 +91,11 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         loss ends (``"fall"``) an event.
     refractory : int, default=15
         The fewest frames between two events.
-    trigger : {"fall", "peak", "rise"}, default="fall"
+    trigger : {"fall", "maximum", "peak", "rise"}, default="fall"
         As for :class:`GestureDetector`.
+    delay : int, default=2
+        With ``trigger="maximum"``: the frames of look-ahead that confirm a
+        maximum (an event comes ``delay`` frames after the window it names).
     jitter : int or (int, int), default=1
         Positive windows also end up to this many frames before and after each
         action point; a pair ``(before, after)`` gives the two sides apart:
@@ -165,6 +168,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         "threshold": [Interval(Real, 0, 1, closed="both")],
         "refractory": [Interval(Integral, 0, None, closed="left")],
         "trigger": [StrOptions(set(TRIGGERS))],
+        "delay": [Interval(Integral, 0, None, closed="left")],
         "jitter": [Interval(Integral, 0, None, closed="left"), tuple, list],
         "n_negatives": [Interval(Integral, 0, None, closed="left")],
         "negative_gap": [Interval(Integral, 0, None, closed="left")],
@@ -185,6 +189,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         threshold=0.5,
         refractory=15,
         trigger="fall",
+        delay=2,
         jitter=1,
         n_negatives=80,
         negative_gap=1,
@@ -200,6 +205,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.threshold = threshold
         self.refractory = refractory
         self.trigger = trigger
+        self.delay = delay
         self.jitter = jitter
         self.n_negatives = n_negatives
         self.negative_gap = negative_gap
@@ -382,7 +388,12 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         events : list of list of Event
             Per take, its events ``(frame, label, score)`` in time order.
         """
-        rule = dict(threshold=self.threshold, refractory=self.refractory, trigger=self.trigger)
+        rule = dict(
+            threshold=self.threshold,
+            refractory=self.refractory,
+            trigger=self.trigger,
+            delay=self.delay,
+        )
         return [
             next_events(ends, proba, self.classes_, self.none_index_, state=TriggerState(), **rule)[
                 0
@@ -418,7 +429,9 @@ class LinearDetectorStream:
             rows, d.bias_, *d._joints(), d.poses_, d.pose_width_, d.segment, d.none_index_
         )  # fmt: skip
         self._classes, self._none = d.classes_, d.none_index_
-        self._rule = dict(threshold=d.threshold, refractory=d.refractory, trigger=d.trigger)
+        self._rule = dict(
+            threshold=d.threshold, refractory=d.refractory, trigger=d.trigger, delay=d.delay
+        )
         self._threshold, self._fall = d.threshold, d.trigger == "fall"
         self._runs = d.trigger in ("fall", "peak")  # the triggers that follow runs of windows
         n_classes = len(d.classes_)
@@ -472,8 +485,8 @@ class LinearDetectorStream:
             proba, score, best = self._score(frames.reshape(1, width), self._one)
             state, top = self._state, float(score[0])
             # the two cases in which next_events would emit nothing, said in scalars
-            if state.run_best is None and top < self._threshold:
-                return []  # below the threshold and no run open: nothing changes
+            if state.run_best is None and state.recent is None and top < self._threshold:
+                return []  # below the threshold, no run open, no maximum pending: no change
             if self._runs and state.run_best is not None and top >= self._threshold:
                 if state.run_score == np.inf:  # "peak" has fired in this run: nothing until it ends
                     return []

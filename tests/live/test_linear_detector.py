@@ -115,7 +115,7 @@ def test_the_stream_equals_the_batch_to_the_bit(fitted, skeleton_takes, chunk):
     assert stream.update(take[:0]) == [] and stream.n_frames == len(take)  # an empty chunk
 
 
-@pytest.mark.parametrize("trigger", ["fall", "peak", "rise"])
+@pytest.mark.parametrize("trigger", ["fall", "maximum", "peak", "rise"])
 @pytest.mark.parametrize("threshold", [0.2, 0.6])
 def test_every_trigger_streams_the_batch_events(fitted, skeleton_takes, trigger, threshold):
     detector = clone(fitted).set_params(trigger=trigger, threshold=threshold, refractory=4)
@@ -132,7 +132,7 @@ def test_every_trigger_streams_the_batch_events(fitted, skeleton_takes, trigger,
     ((ends, proba),) = detector.scores([take])
     expected = next_events(
         ends, proba, detector.classes_, detector.none_index_, threshold=threshold,
-        refractory=4, trigger=trigger, state=TriggerState(),
+        refractory=4, trigger=trigger, state=TriggerState(), delay=detector.delay,
     )[0]  # fmt: skip
     assert batch == expected
 
