@@ -104,6 +104,11 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         motion, and may be drawn as a negative).
     n_negatives : int, default=80
         Windows ending away from action points drawn per training take.
+    hard_negatives : int, default=0
+        Per training take, a second round of training adds this many windows
+        to the rejection class: those the first readout scores highest
+        (gesture probability) among the windows ending more than
+        ``negative_gap`` frames from every positive window's end.
     negative_gap : int, default=1
         A negative window ends more than this many frames from every positive
         window's end.
@@ -171,6 +176,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         "delay": [Interval(Integral, 0, None, closed="left")],
         "jitter": [Interval(Integral, 0, None, closed="left"), tuple, list],
         "n_negatives": [Interval(Integral, 0, None, closed="left")],
+        "hard_negatives": [Interval(Integral, 0, None, closed="left")],
         "negative_gap": [Interval(Integral, 0, None, closed="left")],
         "none_label": [str],
         "random_state": ["random_state"],
@@ -192,6 +198,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         delay=2,
         jitter=1,
         n_negatives=80,
+        hard_negatives=0,
         negative_gap=1,
         none_label="none",
         random_state=None,
@@ -208,6 +215,7 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.delay = delay
         self.jitter = jitter
         self.n_negatives = n_negatives
+        self.hard_negatives = hard_negatives
         self.negative_gap = negative_gap
         self.none_label = none_label
         self.random_state = random_state
@@ -314,19 +322,39 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
             raise ValueError(
                 f"no action point ends a full window of {self.window} frames: shorten the window."
             )
-        means = np.vstack(
-            [
-                segment_means(self._features(c), e, self.n_segments, self.segment)
-                for c, e in zip(clips, ends)
-            ]
-        )
+        features = [self._features(c) for c in clips]
+        means = [segment_means(f, e, self.n_segments, self.segment) for f, e in zip(features, ends)]
+        self._fit_readout(np.vstack(means), np.concatenate(targets))
+        if self.hard_negatives:
+            # a second round: the windows the first readout scores highest away from every
+            # positive end (false alarms, and the frames just before or after a completion)
+            # join the rejection class
+            for k, (clip, f, positive) in enumerate(zip(clips, features, moved)):
+                hard = self._hard_ends(clip, positive, ends[k])
+                means.append(segment_means(f, hard, self.n_segments, self.segment))
+                targets.append(np.full(len(hard), self.none_label, dtype=object))
+            self._fit_readout(np.vstack(means), np.concatenate(targets))
+        return self
+
+    def _hard_ends(self, clip, positive, taken):
+        """The ``hard_negatives`` window ends of ``clip`` the readout scores highest, more than
+        ``negative_gap`` frames from every ``positive`` end and not among ``taken``."""
+        proba, score, _ = self.stream()._score(np.ascontiguousarray(clip, dtype=float))
+        ends = np.arange(self.window - 1, len(clip))
+        if len(positive) and len(ends):
+            far = np.abs(ends[:, None] - positive[None, :]).min(axis=1) > self.negative_gap
+            ends = ends[far]
+        ends = np.setdiff1d(ends, taken)
+        order = np.argsort(-score[ends], kind="stable")[: self.hard_negatives]
+        return np.sort(ends[order])
+
+    def _fit_readout(self, means, targets):
+        """The logistic regression on standardised segment means, and its per-frame weights."""
         # StandardScaler leaves constant columns (up to rounding: a root joint) unscaled
         scaler = StandardScaler().fit(means)
         self.mean_, self.scale_ = scaler.mean_, scaler.scale_
         classifier = LogisticRegression(C=self.C, max_iter=3000)
-        self.classifier_ = classifier.fit(
-            (means - self.mean_) / self.scale_, np.concatenate(targets)
-        )
+        self.classifier_ = classifier.fit((means - self.mean_) / self.scale_, targets)
         self.classes_ = classifier.classes_
         found = np.flatnonzero(self.classes_ == self.none_label)
         if not len(found):
@@ -343,7 +371,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.weights_ = np.ascontiguousarray(
             (coef / self.segment).T.reshape(self.n_segments, n_features, len(self.classes_))
         )
-        return self
 
     def stream(self):
         """A stream fed frame by frame, emitting the events of :meth:`detect`.
