@@ -512,8 +512,12 @@ class LinearDetectorStream:
             proba, score, best = self._score(frames.reshape(1, width), self._one)
             state, top = self._state, float(score[0])
             # the two cases in which next_events would emit nothing, said in scalars
-            if state.run_best is None and state.recent is None and top < self._threshold:
-                return []  # below the threshold, no run open, no maximum pending: no change
+            if state.run_best is None and top < self._threshold:
+                # below the threshold, no run open and no maximum waiting for its look-ahead
+                # (rows are decided in order: the last one's flag says all): no event, and
+                # the windows kept can decide nothing more (they are dropped at the next call)
+                if state.recent is None or state.recent[-1, 3] == 1.0:
+                    return []
             if self._runs and state.run_best is not None and top >= self._threshold:
                 if state.run_score == np.inf:  # "peak" has fired in this run: nothing until it ends
                     return []
