@@ -67,7 +67,8 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     window is scored at every frame for a few microseconds, in constant
     memory; the batch :meth:`scores` run the same loop, so stream and batch
     agree to the last bit. The events come from the decision rule of
-    :class:`GestureDetector` (``trigger``, ``threshold``, ``refractory``).
+    :class:`GestureDetector` (``trigger``, ``threshold``, ``refractory``,
+    ``delay``).
 
     Parameters
     ----------
@@ -161,6 +162,10 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     >>> stream = detector.stream()                       # the same, one frame at a time
     >>> [event.frame for frame in take for event in stream.update(frame)]
     [51, 121, 191, 262, 332]
+    >>> # trigger="maximum": ``delay`` (2) frames after the window of the highest score
+    >>> detector = detector.set_params(trigger="maximum")
+    >>> [event.frame for event in detector.detect([take])[0]]
+    [48, 121, 191, 261, 331]
     """
 
     _parameter_constraints = {
