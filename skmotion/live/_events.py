@@ -2,7 +2,7 @@
 
 A detector scores a window every ``step`` frames: one probability per class,
 the "nothing known" class among them; a window's *score* is its best
-motion's probability. Three triggers turn scores into events:
+motion's probability. Four triggers turn scores into events:
 
 - ``"rise"``: an event at the first window whose score reaches
   ``threshold`` (the earliest answer; a recogniser that knows a motion before
@@ -27,7 +27,7 @@ motion's probability. Three triggers turn scores into events:
   budget, picks the true peak of a score that peaks at the completion, where
   ``"peak"`` fires at its first downturn.
 
-In both, an event needs ``refractory`` frames since the last one. The
+In all, an event needs ``refractory`` frames since the last one. The
 threshold trades misses for false alarms and, with the trigger, latency.
 Both the batch ``detect`` and the stream call :func:`next_events` with the
 same state, so they emit the same events from the same scores.
