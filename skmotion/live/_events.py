@@ -210,3 +210,36 @@ def _maximum_events(ends, best, score, above, classes, refractory, delay, state)
     if len(ends):  # a later window can only be compared with the last 2 * delay frames
         rows = rows[end > ends[-1] - 2 * delay]
     return events, TriggerState(last, None, -np.inf, rows if len(rows) else None)
+
+
+def maximum_step(state, end, score, best, classes, *, threshold, refractory, delay):
+    """:func:`next_events` with ``trigger="maximum"`` on one window, in Python scalars.
+
+    The same decisions as :func:`_maximum_events` on a single window ``end``
+    with its best motion's column ``best`` and probability ``score`` (the
+    stream's one-frame path: a few rows, no array operations but the state's).
+
+    Returns
+    -------
+    events : list of Event
+    state : TriggerState
+    """
+    rows = [] if state.recent is None else state.recent.tolist()
+    if score >= threshold:
+        rows.append([float(end), score, float(best), 0.0])
+    last, events = state.last, []
+    for row in rows:
+        row_end, value = row[0], row[1]
+        if row[3] or row_end + delay > end:  # decided before, or its look-ahead not over
+            continue
+        row[3] = 1.0
+        peak = all(
+            not (0 < row_end - e <= delay and v >= value)
+            and not (0 < e - row_end <= delay and v > value)
+            for e, v, _, _ in rows
+        )
+        if peak and (last is None or end - last >= refractory):
+            events.append(Event(int(end), classes[int(row[2])], float(value)))
+            last = int(end)
+    rows = [row for row in rows if row[0] > end - 2 * delay]
+    return events, TriggerState(last, None, -np.inf, np.array(rows) if rows else None)

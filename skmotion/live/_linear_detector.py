@@ -12,7 +12,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.live._detector import training_takes
-from skmotion.live._events import TRIGGERS, TriggerState, next_events
+from skmotion.live._events import TRIGGERS, TriggerState, maximum_step, next_events
 from skmotion.live._window_kernel import frame_features, window_scores
 from skmotion.live._windows import training_ends
 from skmotion.utils._clips import check_clips
@@ -469,6 +469,8 @@ class LinearDetectorStream:
         )
         self._threshold, self._fall = d.threshold, d.trigger == "fall"
         self._runs = d.trigger in ("fall", "peak")  # the triggers that follow runs of windows
+        self._maximum = d.trigger == "maximum"
+        self._step = dict(threshold=d.threshold, refractory=d.refractory, delay=d.delay)
         n_classes = len(d.classes_)
         self._ring = np.zeros((d.window, d.n_segments, n_classes))
         self._previous = np.zeros(d.n_features_in_)
@@ -534,6 +536,11 @@ class LinearDetectorStream:
                     return []
                 if self._fall or top == state.run_score:
                     return []
+            if self._maximum:  # the same rule in scalars: a few rows, no array operations
+                events, self._state = maximum_step(
+                    state, self.n_frames - 1, top, int(best[0]), self._classes, **self._step
+                )
+                return events
             start = self.n_frames - 1
         else:
             if frames.ndim != 2 or frames.shape[1] != width:

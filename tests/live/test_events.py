@@ -4,7 +4,7 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from skmotion.live._events import TriggerState, next_events
+from skmotion.live._events import TriggerState, gesture_scores, maximum_step, next_events
 
 CLASSES = np.array(["a", "b", "none"], dtype=object)
 
@@ -59,6 +59,16 @@ def test_maximum_trigger_equals_brute_force_in_any_chunks(
         found, state = next_events(ends[part], proba[part], CLASSES, 2, state=state, **rule)
         streamed += found
     assert streamed == whole
+    # the stream's one-window path in scalars: the same events
+    best, score = gesture_scores(proba, 2)
+    state, one_by_one = TriggerState(), []
+    for end, column, value in zip(ends, best, score):
+        found, state = maximum_step(
+            state, int(end), float(value), int(column), CLASSES,
+            threshold=0.4, refractory=refractory, delay=delay,
+        )  # fmt: skip
+        one_by_one += found
+    assert one_by_one == whole
     # constant memory: the state keeps at most the windows of the last 2 * delay frames
     assert state.recent is None or len(state.recent) <= 2 * delay + 1
 
