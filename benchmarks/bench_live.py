@@ -23,9 +23,11 @@ Result tables, all measured in one run:
   and MSRC-12 repetitions (two per take, odd people train).
 - ``live_detection`` (MSRC-12): detection F1 at 0.2, 0.5 and 1.0 s, per
   gesture and overall, of ``GestureDetector`` with the recommended recogniser,
-  an ordered one and aeon's MiniRocket on the same windows (same step), the
-  event rule chosen by GroupKFold over the training people; microseconds per
-  frame, one frame per call and batched (``_live_detection.py``).
+  an ordered one and aeon's MiniRocket on the same windows (same step), and of
+  ``LinearGestureDetector``; the event rule (trigger, look-ahead, threshold,
+  refractory period) chosen by GroupKFold over the training people for F1 at
+  0.5 s, and again for each latency (rows "rule chosen for this latency");
+  microseconds per frame, one frame per call and batched (``_live_detection.py``).
 - ``live_labelling`` (MSRC-12): frame accuracy of ``ActivitySegmenter`` (windows
   of ``MotionClassifier``: its defaults, its standardised columns or both averaged,
   chosen with the switch penalty by GroupKFold over the training people) on

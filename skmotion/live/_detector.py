@@ -103,7 +103,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         loss ends (``"fall"``) an event.
     refractory : int, default=15
         The fewest frames between two events.
-    trigger : {"fall", "peak", "rise"}, default="fall"
+    trigger : {"fall", "maximum", "peak", "rise"}, default="fall"
         ``"rise"``: an event at the first window whose score reaches
         ``threshold``; ``"fall"``: when the score falls back below it after
         a run at or above it, with the run's best motion and score (a window
@@ -111,7 +111,11 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         completion, where a recogniser that knows a motion early rises long
         before it); ``"peak"``: in such a run, at the first window whose
         score is below the run's best so far (one window after the peak; at
-        the run's end if it never turns down), once per run.
+        the run's end if it never turns down), once per run; ``"maximum"``:
+        ``delay`` frames after a window at or above ``threshold`` whose score
+        is the highest of the windows ending within ``delay`` frames of it.
+    delay : int, default=2
+        The look-ahead of ``trigger="maximum"``, in frames.
     n_negatives : int, default=20
         Windows ending away from action points drawn per training take.
     negative_gap : int, default=3
@@ -168,6 +172,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         "threshold": [Interval(Real, 0, 1, closed="both")],
         "refractory": [Interval(Integral, 0, None, closed="left")],
         "trigger": [StrOptions(set(TRIGGERS))],
+        "delay": [Interval(Integral, 0, None, closed="left")],
         "n_negatives": [Interval(Integral, 0, None, closed="left")],
         "negative_gap": [Interval(Integral, 0, None, closed="left")],
         "none_label": [str],
@@ -184,6 +189,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         threshold=0.5,
         refractory=15,
         trigger="fall",
+        delay=2,
         n_negatives=20,
         negative_gap=3,
         none_label="none",
@@ -195,6 +201,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.threshold = threshold
         self.refractory = refractory
         self.trigger = trigger
+        self.delay = delay
         self.n_negatives = n_negatives
         self.negative_gap = negative_gap
         self.none_label = none_label
@@ -296,6 +303,7 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
                 threshold=self.threshold,
                 refractory=self.refractory,
                 trigger=self.trigger,
+                delay=self.delay,
                 state=TriggerState(),
             )
             out.append(events)
@@ -321,4 +329,5 @@ class GestureDetector(ClipEstimatorMixin, BaseEstimator):
             threshold=self.threshold,
             refractory=self.refractory,
             trigger=self.trigger,
+            delay=self.delay,
         )

@@ -2,7 +2,7 @@
 
 A detector scores a window every ``step`` frames: one probability per class,
 the "nothing known" class among them; a window's *score* is its best
-motion's probability. Three triggers turn scores into events:
+motion's probability. Four triggers turn scores into events:
 
 - ``"rise"``: an event at the first window whose score reaches
   ``threshold`` (the earliest answer; a recogniser that knows a motion before
@@ -18,8 +18,16 @@ motion's probability. Three triggers turn scores into events:
   score; a run that never turns down fires as ``"fall"``, at its end. One
   event per run at most. For a recogniser whose score peaks as a motion
   completes: the event comes one window after the peak.
+- ``"maximum"``: an event ``delay`` frames after a window whose score is at
+  or above ``threshold`` and the highest of every window ending within
+  ``delay`` frames before or after it (strictly above those before it, at
+  least those after it: one event per plateau), labelled with that window's
+  best motion and score; emitted at the first window ending ``delay`` frames
+  or more after it. A look-ahead of a few frames, a part of the latency
+  budget, picks the true peak of a score that peaks at the completion, where
+  ``"peak"`` fires at its first downturn.
 
-In both, an event needs ``refractory`` frames since the last one. The
+In all, an event needs ``refractory`` frames since the last one. The
 threshold trades misses for false alarms and, with the trigger, latency.
 Both the batch ``detect`` and the stream call :func:`next_events` with the
 same state, so they emit the same events from the same scores.
@@ -31,7 +39,7 @@ import numpy as np
 
 __all__ = ["Event", "TRIGGERS", "TriggerState", "gesture_scores", "next_events"]
 
-TRIGGERS = ("fall", "peak", "rise")
+TRIGGERS = ("fall", "maximum", "peak", "rise")
 
 
 class Event(NamedTuple):
@@ -48,12 +56,17 @@ class TriggerState(NamedTuple):
     ``last``: the frame of the last event (None: none yet); ``run_best`` and
     ``run_score``: the best motion's column and score in the current run of
     windows at or above the threshold (``run_best`` None: no run; ``run_score``
-    infinite: the ``"peak"`` trigger has fired in this run).
+    infinite: the ``"peak"`` trigger has fired in this run); ``recent``
+    (``"maximum"`` only): the windows at or above the threshold that a later
+    window may still decide, an array of rows ``(end, score, best, decided)``
+    covering at most the last ``2 * delay`` frames (windows below the threshold
+    can neither be a maximum nor hide one, so they are not kept).
     """
 
     last: object = None
     run_best: object = None
     run_score: float = -np.inf
+    recent: object = None
 
 
 def gesture_scores(proba, none_index):
@@ -65,7 +78,9 @@ def gesture_scores(proba, none_index):
     return best, masked[np.arange(len(masked)), best]
 
 
-def next_events(ends, proba, classes, none_index, *, threshold, refractory, trigger, state):
+def next_events(
+    ends, proba, classes, none_index, *, threshold, refractory, trigger, state, delay=0
+):
     """Events among scored windows, in order, and the rule's state after them.
 
     Parameters
@@ -82,9 +97,11 @@ def next_events(ends, proba, classes, none_index, *, threshold, refractory, trig
         The score that starts (``"rise"``) or whose loss ends (``"fall"``) an event.
     refractory : int
         The fewest frames between two events.
-    trigger : {"fall", "peak", "rise"}
+    trigger : {"fall", "maximum", "peak", "rise"}
     state : TriggerState
         The state after the previous windows (``TriggerState()`` at the start).
+    delay : int, default=0
+        The look-ahead of ``"maximum"``, in frames (the other triggers ignore it).
 
     Returns
     -------
@@ -93,7 +110,9 @@ def next_events(ends, proba, classes, none_index, *, threshold, refractory, trig
     """
     best, score = gesture_scores(proba, none_index)
     above = score >= threshold
-    last, run_best, run_score = state
+    last, run_best, run_score = state[:3]
+    if trigger == "maximum":
+        return _maximum_events(ends, best, score, above, classes, refractory, delay, state)
     events = []
     if trigger == "rise":
         # only the windows at or above the threshold can emit: a short loop, not one per frame
@@ -133,7 +152,7 @@ def _peak_events(ends, best, score, above, classes, refractory, state):
     Only the windows at or above the threshold and the first one below after
     each run can change anything: a loop over those, not over every window.
     """
-    last, run_best, run_score = state
+    last, run_best, run_score = state[:3]
     was_above = np.r_[run_best is not None, above[:-1]]
     events = []
 
@@ -156,3 +175,71 @@ def _peak_events(ends, best, score, above, classes, refractory, state):
             emit(i, run_best, run_score)
             run_score = np.inf
     return events, TriggerState(last, run_best, run_score)
+
+
+def _maximum_events(ends, best, score, above, classes, refractory, delay, state):
+    """The ``"maximum"`` trigger: :func:`next_events` on windows with their best motions and scores.
+
+    Only the windows at or above the threshold can be a maximum or hide one:
+    the state's undecided ones and the new ones are compared with each other
+    (at most ``delay`` neighbours on either side), and each is decided at the
+    first new window ending ``delay`` frames after it.
+    """
+    new = np.column_stack(
+        [np.asarray(ends, dtype=float), score, best.astype(float), np.zeros(len(score))]
+    )[above]
+    rows = new if state.recent is None else np.vstack([state.recent, new])
+    end, value = rows[:, 0], rows[:, 1]
+    n = len(rows)
+    peak = np.ones(n, dtype=bool)
+    for k in range(1, delay + 1):  # ends are distinct frames: at most `delay` on each side
+        near = end[k:] - end[:-k] <= delay if n > k else np.zeros(0, dtype=bool)
+        peak[k:] &= ~(near & (value[:-k] >= value[k:]))  # an earlier window as high
+        peak[:-k] &= ~(near & (value[k:] > value[:-k]))  # a later window higher
+    # decided now: the first new window ending `delay` frames after it exists
+    at = np.searchsorted(ends, end + delay, side="left")
+    ready = (rows[:, 3] == 0) & (at < len(ends))
+    last = state.last
+    events = []
+    for i in np.flatnonzero(ready & peak):
+        frame = int(ends[at[i]])
+        if last is None or frame - last >= refractory:
+            events.append(Event(frame, classes[int(rows[i, 2])], float(value[i])))
+            last = frame
+    rows[ready, 3] = 1.0
+    if len(ends):  # a later window can only be compared with the last 2 * delay frames
+        rows = rows[end > ends[-1] - 2 * delay]
+    return events, TriggerState(last, None, -np.inf, rows if len(rows) else None)
+
+
+def maximum_step(state, end, score, best, classes, *, threshold, refractory, delay):
+    """:func:`next_events` with ``trigger="maximum"`` on one window, in Python scalars.
+
+    The same decisions as :func:`_maximum_events` on a single window ``end``
+    with its best motion's column ``best`` and probability ``score`` (the
+    stream's one-frame path: a few rows, no array operations but the state's).
+
+    Returns
+    -------
+    events : list of Event
+    state : TriggerState
+    """
+    rows = [] if state.recent is None else state.recent.tolist()
+    if score >= threshold:
+        rows.append([float(end), score, float(best), 0.0])
+    last, events = state.last, []
+    for row in rows:
+        row_end, value = row[0], row[1]
+        if row[3] or row_end + delay > end:  # decided before, or its look-ahead not over
+            continue
+        row[3] = 1.0
+        peak = all(
+            not (0 < row_end - e <= delay and v >= value)
+            and not (0 < e - row_end <= delay and v > value)
+            for e, v, _, _ in rows
+        )
+        if peak and (last is None or end - last >= refractory):
+            events.append(Event(int(end), classes[int(row[2])], float(value)))
+            last = int(end)
+    rows = [row for row in rows if row[0] > end - 2 * delay]
+    return events, TriggerState(last, None, -np.inf, np.array(rows) if rows else None)

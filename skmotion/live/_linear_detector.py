@@ -12,7 +12,7 @@ from sklearn.utils.validation import check_is_fitted
 
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.live._detector import training_takes
-from skmotion.live._events import TRIGGERS, TriggerState, next_events
+from skmotion.live._events import TRIGGERS, TriggerState, maximum_step, next_events
 from skmotion.live._window_kernel import frame_features, window_scores
 from skmotion.live._windows import training_ends
 from skmotion.utils._clips import check_clips
@@ -67,7 +67,8 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     window is scored at every frame for a few microseconds, in constant
     memory; the batch :meth:`scores` run the same loop, so stream and batch
     agree to the last bit. The events come from the decision rule of
-    :class:`GestureDetector` (``trigger``, ``threshold``, ``refractory``).
+    :class:`GestureDetector` (``trigger``, ``threshold``, ``refractory``,
+    ``delay``).
 
     Parameters
     ----------
@@ -86,13 +87,19 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         Two joints whose distance divides the positions; None: no division.
     C : float, default=0.01
         Inverse regularisation of the logistic regression (on standardised segment means).
-    threshold : float, default=0.5
+    threshold : float, default=0.45
         The probability of the best motion that starts (``"rise"``) or whose
         loss ends (``"fall"``) an event.
     refractory : int, default=15
         The fewest frames between two events.
-    trigger : {"fall", "peak", "rise"}, default="fall"
-        As for :class:`GestureDetector`.
+    trigger : {"fall", "maximum", "peak", "rise"}, default="maximum"
+        As for :class:`GestureDetector`. The defaults of the rule (``"maximum"``,
+        look-ahead 3 frames, threshold 0.45, refractory period 15 frames) are
+        the choice of ``GroupKFold(3)`` over the MSRC-12 training people
+        (``benchmarks/bench_live.py --only detection``).
+    delay : int, default=3
+        With ``trigger="maximum"``: the frames of look-ahead that confirm a
+        maximum (an event comes ``delay`` frames after the window it names).
     jitter : int or (int, int), default=1
         Positive windows also end up to this many frames before and after each
         action point; a pair ``(before, after)`` gives the two sides apart:
@@ -101,6 +108,11 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         motion, and may be drawn as a negative).
     n_negatives : int, default=80
         Windows ending away from action points drawn per training take.
+    hard_negatives : int, default=0
+        Per training take, a second round of training adds this many windows
+        to the rejection class: those the first readout scores highest
+        (gesture probability) among the windows ending more than
+        ``negative_gap`` frames from every positive window's end.
     negative_gap : int, default=1
         A negative window ends more than this many frames from every positive
         window's end.
@@ -147,12 +159,16 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     ...     take[end - 19 : end + 1] += np.linspace(0, 1, 20)[:, None]
     >>> detector = LinearGestureDetector(random_state=0)
     >>> detector = detector.fit([take], ["rise"], action_points=[points])
-    >>> # trigger="fall": a few frames after each completion, as the score drops
+    >>> # trigger="maximum": ``delay`` (3) frames after the window of the highest score
     >>> [event.frame for event in detector.detect([take])[0]]
-    [51, 121, 191, 262, 332]
+    [49, 122, 192, 262, 332]
     >>> stream = detector.stream()                       # the same, one frame at a time
     >>> [event.frame for frame in take for event in stream.update(frame)]
-    [51, 121, 191, 262, 332]
+    [49, 122, 192, 262, 332]
+    >>> # trigger="fall": when the score drops below the threshold after its run above it
+    >>> detector = detector.set_params(trigger="fall")
+    >>> [event.frame for event in detector.detect([take])[0]]
+    [52, 122, 192, 262, 332]
     """
 
     _parameter_constraints = {
@@ -165,8 +181,10 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         "threshold": [Interval(Real, 0, 1, closed="both")],
         "refractory": [Interval(Integral, 0, None, closed="left")],
         "trigger": [StrOptions(set(TRIGGERS))],
+        "delay": [Interval(Integral, 0, None, closed="left")],
         "jitter": [Interval(Integral, 0, None, closed="left"), tuple, list],
         "n_negatives": [Interval(Integral, 0, None, closed="left")],
+        "hard_negatives": [Interval(Integral, 0, None, closed="left")],
         "negative_gap": [Interval(Integral, 0, None, closed="left")],
         "none_label": [str],
         "random_state": ["random_state"],
@@ -182,11 +200,13 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         root=None,
         size_joints=None,
         C=0.01,
-        threshold=0.5,
+        threshold=0.45,
         refractory=15,
-        trigger="fall",
+        trigger="maximum",
+        delay=3,
         jitter=1,
         n_negatives=80,
+        hard_negatives=0,
         negative_gap=1,
         none_label="none",
         random_state=None,
@@ -200,8 +220,10 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.threshold = threshold
         self.refractory = refractory
         self.trigger = trigger
+        self.delay = delay
         self.jitter = jitter
         self.n_negatives = n_negatives
+        self.hard_negatives = hard_negatives
         self.negative_gap = negative_gap
         self.none_label = none_label
         self.random_state = random_state
@@ -308,19 +330,39 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
             raise ValueError(
                 f"no action point ends a full window of {self.window} frames: shorten the window."
             )
-        means = np.vstack(
-            [
-                segment_means(self._features(c), e, self.n_segments, self.segment)
-                for c, e in zip(clips, ends)
-            ]
-        )
+        features = [self._features(c) for c in clips]
+        means = [segment_means(f, e, self.n_segments, self.segment) for f, e in zip(features, ends)]
+        self._fit_readout(np.vstack(means), np.concatenate(targets))
+        if self.hard_negatives:
+            # a second round: the windows the first readout scores highest away from every
+            # positive end (false alarms, and the frames just before or after a completion)
+            # join the rejection class
+            for k, (clip, f, positive) in enumerate(zip(clips, features, moved)):
+                hard = self._hard_ends(clip, positive, ends[k])
+                means.append(segment_means(f, hard, self.n_segments, self.segment))
+                targets.append(np.full(len(hard), self.none_label, dtype=object))
+            self._fit_readout(np.vstack(means), np.concatenate(targets))
+        return self
+
+    def _hard_ends(self, clip, positive, taken):
+        """The ``hard_negatives`` window ends of ``clip`` the readout scores highest, more than
+        ``negative_gap`` frames from every ``positive`` end and not among ``taken``."""
+        proba, score, _ = self.stream()._score(np.ascontiguousarray(clip, dtype=float))
+        ends = np.arange(self.window - 1, len(clip))
+        if len(positive) and len(ends):
+            far = np.abs(ends[:, None] - positive[None, :]).min(axis=1) > self.negative_gap
+            ends = ends[far]
+        ends = np.setdiff1d(ends, taken)
+        order = np.argsort(-score[ends], kind="stable")[: self.hard_negatives]
+        return np.sort(ends[order])
+
+    def _fit_readout(self, means, targets):
+        """The logistic regression on standardised segment means, and its per-frame weights."""
         # StandardScaler leaves constant columns (up to rounding: a root joint) unscaled
         scaler = StandardScaler().fit(means)
         self.mean_, self.scale_ = scaler.mean_, scaler.scale_
         classifier = LogisticRegression(C=self.C, max_iter=3000)
-        self.classifier_ = classifier.fit(
-            (means - self.mean_) / self.scale_, np.concatenate(targets)
-        )
+        self.classifier_ = classifier.fit((means - self.mean_) / self.scale_, targets)
         self.classes_ = classifier.classes_
         found = np.flatnonzero(self.classes_ == self.none_label)
         if not len(found):
@@ -337,7 +379,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.weights_ = np.ascontiguousarray(
             (coef / self.segment).T.reshape(self.n_segments, n_features, len(self.classes_))
         )
-        return self
 
     def stream(self):
         """A stream fed frame by frame, emitting the events of :meth:`detect`.
@@ -382,7 +423,12 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         events : list of list of Event
             Per take, its events ``(frame, label, score)`` in time order.
         """
-        rule = dict(threshold=self.threshold, refractory=self.refractory, trigger=self.trigger)
+        rule = dict(
+            threshold=self.threshold,
+            refractory=self.refractory,
+            trigger=self.trigger,
+            delay=self.delay,
+        )
         return [
             next_events(ends, proba, self.classes_, self.none_index_, state=TriggerState(), **rule)[
                 0
@@ -418,9 +464,13 @@ class LinearDetectorStream:
             rows, d.bias_, *d._joints(), d.poses_, d.pose_width_, d.segment, d.none_index_
         )  # fmt: skip
         self._classes, self._none = d.classes_, d.none_index_
-        self._rule = dict(threshold=d.threshold, refractory=d.refractory, trigger=d.trigger)
+        self._rule = dict(
+            threshold=d.threshold, refractory=d.refractory, trigger=d.trigger, delay=d.delay
+        )
         self._threshold, self._fall = d.threshold, d.trigger == "fall"
         self._runs = d.trigger in ("fall", "peak")  # the triggers that follow runs of windows
+        self._maximum = d.trigger == "maximum"
+        self._step = dict(threshold=d.threshold, refractory=d.refractory, delay=d.delay)
         n_classes = len(d.classes_)
         self._ring = np.zeros((d.window, d.n_segments, n_classes))
         self._previous = np.zeros(d.n_features_in_)
@@ -473,7 +523,11 @@ class LinearDetectorStream:
             state, top = self._state, float(score[0])
             # the two cases in which next_events would emit nothing, said in scalars
             if state.run_best is None and top < self._threshold:
-                return []  # below the threshold and no run open: nothing changes
+                # below the threshold, no run open and no maximum waiting for its look-ahead
+                # (rows are decided in order: the last one's flag says all): no event, and
+                # the windows kept can decide nothing more (they are dropped at the next call)
+                if state.recent is None or state.recent[-1, 3] == 1.0:
+                    return []
             if self._runs and state.run_best is not None and top >= self._threshold:
                 if state.run_score == np.inf:  # "peak" has fired in this run: nothing until it ends
                     return []
@@ -482,6 +536,11 @@ class LinearDetectorStream:
                     return []
                 if self._fall or top == state.run_score:
                     return []
+            if self._maximum:  # the same rule in scalars: a few rows, no array operations
+                events, self._state = maximum_step(
+                    state, self.n_frames - 1, top, int(best[0]), self._classes, **self._step
+                )
+                return events
             start = self.n_frames - 1
         else:
             if frames.ndim != 2 or frames.shape[1] != width:

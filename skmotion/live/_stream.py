@@ -28,7 +28,9 @@ class DetectorStream:
     none_index : int
     threshold : float
     refractory : int
-    trigger : {"fall", "peak", "rise"}, default="fall"
+    trigger : {"fall", "maximum", "peak", "rise"}, default="fall"
+    delay : int, default=0
+        The look-ahead of ``"maximum"``, in frames.
 
     Attributes
     ----------
@@ -50,11 +52,13 @@ class DetectorStream:
         threshold,
         refractory,
         trigger="fall",
+        delay=0,
     ):
         self._score = score
         self._window, self._step = int(window), int(step)
         self._classes, self._none = classes, none_index
         self._threshold, self._refractory, self._trigger = threshold, refractory, trigger
+        self._delay = int(delay)
         self._buffer = np.zeros((2 * self._window, int(n_channels)))
         self.reset()
 
@@ -107,6 +111,7 @@ class DetectorStream:
                     threshold=self._threshold,
                     refractory=self._refractory,
                     trigger=self._trigger,
+                    delay=self._delay,
                     state=self._state,
                 )
                 events += new

@@ -29,7 +29,7 @@ def planted_take(seed, n_reps=6, gap=45, ramp=20):
     return take, points, labels
 
 
-@pytest.fixture(scope="module", params=["fall", "rise"])
+@pytest.fixture(scope="module", params=["fall", "maximum", "rise"])
 def planted(request):
     takes, points, labels = zip(*(planted_take(seed) for seed in range(6)))
     detector = GestureDetector(
@@ -42,7 +42,7 @@ def planted(request):
 def test_events_come_at_the_planted_ends_with_their_labels(planted):
     detector, takes, points, labels = planted
     # "rise": as the window starts to match, a few frames before the end; "fall": when it
-    # stops matching, a few frames after
+    # stops matching, a few frames after; "maximum": ``delay`` (2) frames after the best window
     low, high = (-4, 0) if detector.trigger == "rise" else (1, 6)
     events = detector.detect(list(takes))
     for found, ends, names in zip(events, points, labels):

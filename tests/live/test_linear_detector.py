@@ -1,5 +1,6 @@
 """LinearGestureDetector: compiled window scores = a brute-force reference, stream = batch."""
 
+import copy
 import gc
 import sys
 
@@ -115,7 +116,7 @@ def test_the_stream_equals_the_batch_to_the_bit(fitted, skeleton_takes, chunk):
     assert stream.update(take[:0]) == [] and stream.n_frames == len(take)  # an empty chunk
 
 
-@pytest.mark.parametrize("trigger", ["fall", "peak", "rise"])
+@pytest.mark.parametrize("trigger", ["fall", "maximum", "peak", "rise"])
 @pytest.mark.parametrize("threshold", [0.2, 0.6])
 def test_every_trigger_streams_the_batch_events(fitted, skeleton_takes, trigger, threshold):
     detector = clone(fitted).set_params(trigger=trigger, threshold=threshold, refractory=4)
@@ -132,7 +133,7 @@ def test_every_trigger_streams_the_batch_events(fitted, skeleton_takes, trigger,
     ((ends, proba),) = detector.scores([take])
     expected = next_events(
         ends, proba, detector.classes_, detector.none_index_, threshold=threshold,
-        refractory=4, trigger=trigger, state=TriggerState(),
+        refractory=4, trigger=trigger, state=TriggerState(), delay=detector.delay,
     )[0]  # fmt: skip
     assert batch == expected
 
@@ -243,3 +244,33 @@ def test_msrc12_two_gestures_are_detected_near_their_action_points():
     # measured 0.760 (two gestures, four training people; 0.647 before the reference poses,
     # with threshold 0.7); events at random frames score near 0
     assert detection_f1(pick(points, ~train), names, events, latency=8) >= 0.65
+
+
+def test_hard_negatives_are_the_highest_scored_windows_away_from_positives(fitted, skeleton_takes):
+    takes, points, labels = skeleton_takes
+    take, positive = takes[0], np.asarray(points[0])[:, None] + np.array([-1, 0, 1])
+    positive = positive.ravel()
+    taken = np.array([30, 31, 200])
+    hard = (
+        clone(fitted)
+        .set_params(hard_negatives=6)
+        .fit(takes[:4], labels[:4], action_points=points[:4])
+    )
+    # brute force, on the first-round readout (the detector fitted without them)
+    ((ends, proba),) = fitted.scores([take])
+    score = np.delete(proba, fitted.none_index_, axis=1).max(axis=1)
+    allowed = [
+        (s, e)
+        for s, e in zip(score, ends)
+        if np.abs(e - positive).min() > fitted.negative_gap and e not in taken
+    ]
+    expected = sorted(e for _, e in sorted(allowed, key=lambda pair: -pair[0])[:6])
+    first_round = copy.deepcopy(fitted)
+    first_round.hard_negatives = 6
+    np.testing.assert_array_equal(first_round._hard_ends(take, positive, taken), expected)
+    # the second round learns them as "nothing": their gesture scores fall
+    chosen = first_round._hard_ends(take, positive, np.zeros(0, dtype=int)) - fitted.window + 1
+    ((_, after),) = hard.scores([take])
+    again = np.delete(after, hard.none_index_, axis=1).max(axis=1)
+    assert np.mean(again[chosen]) < np.mean(score[chosen])
+    assert detection_f1(points[4:], labels[4:], hard.detect(takes[4:]), latency=6) == 1.0
