@@ -54,7 +54,7 @@ from skmotion.io import Motion, as_motions, read_bvh  # noqa: E402
 from skmotion.kinematics import get_layout  # noqa: E402
 from skmotion.kinematics._layouts import layout_plan  # noqa: E402
 from skmotion.neighbors import MotionMatcher, find_occurrences  # noqa: E402
-from skmotion.neighbors._motion_matcher import _hnsw_index  # noqa: E402
+from skmotion.neighbors._hnsw import hnsw_index  # noqa: E402
 from skmotion.planning import follow_path  # noqa: E402
 from skmotion.preprocessing._position_frame import position_frame_features  # noqa: E402
 
@@ -119,7 +119,7 @@ def _contenders(matcher, matcher_kw):
         m.features_, m.take_, m.frame_ = matcher.features_, matcher.take_, matcher.frame_
         if algorithm == "hnsw":
             # MotionMatcher's graph (its degree and beam) on two threads, to save time.
-            m.index_, m._ef_set = _hnsw_index(m.features_, BUILD_THREADS), None
+            m._set_graph(hnsw_index(m.features_, BUILD_THREADS))
         else:
             m._build()
         build = time.perf_counter() - start
