@@ -5,12 +5,11 @@ microseconds inside faiss; what a Python wrapper does around it (input
 checks, conversions, faiss's own Python checks, allocating and reshaping the
 answer) can cost as much again. :meth:`HnswSearch.one` keeps that to a few
 microseconds for the common case of motion matching, one query row per call:
-the graph's SWIG objects, the compiled search method and the query's
-buffer are looked up or made once,
-the query is checked for NaN and inf by its answer (a non-finite coordinate
-makes every distance non-finite, and faiss then finds no neighbour) instead of
-by a pass over it beforehand, and
-the answer is built by three array operations.
+the graph's SWIG objects, the compiled search method and the query's buffer
+are looked up or made once, the query is checked for NaN and inf by its
+answer (a non-finite coordinate makes every distance non-finite, and faiss
+then finds no neighbour) instead of by a pass over it beforehand, and the
+answer is built by three array operations.
 """
 
 import threading
@@ -80,10 +79,13 @@ class HnswSearch:
     Notes
     -----
     The search beam is written into the graph here alone, so that what is
-    remembered of it is what the graph holds. The query, distance and row
-    buffers are allocated per call (a few hundred nanoseconds each), not kept:
-    faiss releases the GIL while it searches, so buffers shared between calls
-    would let two threads overwrite each other's query.
+    remembered of it is what the graph holds (it is the graph's, shared by
+    every thread). :meth:`one` reuses a query buffer and answer buffers, with
+    faiss's pointers to them, from call to call: fresh ones cost 3-5
+    microseconds more per call (the allocations and SWIG's conversion of new
+    pointers). They are kept per thread: faiss releases the GIL while it
+    searches, so buffers shared between threads would let one overwrite
+    another's query.
     """
 
     def __init__(self, index, take, frame):

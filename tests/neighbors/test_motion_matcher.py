@@ -193,6 +193,29 @@ def test_hnsw_one_query_per_call_answers_as_the_batch(walks, k):
     assert "_graph" not in vars(matcher)
 
 
+def test_hnsw_one_query_per_call_from_threads(walks):
+    # The single-row buffers are per thread: four threads asking one row per call at
+    # once each get the batch's answer for their own rows.
+    pytest.importorskip("faiss")
+    from concurrent.futures import ThreadPoolExecutor
+
+    takes, new = walks
+    matcher = MotionMatcher(algorithm="hnsw").fit(takes)
+    queries = np.concatenate(matcher.frame_features(new))
+    batch = matcher.kneighbors(queries, n_neighbors=2)
+
+    def ask(part):
+        return [matcher.kneighbors(queries[i], n_neighbors=2) for i in part]
+
+    parts = [range(j, len(queries), 4) for j in range(4)]
+    with ThreadPoolExecutor(4) as pool:
+        answers = list(pool.map(ask, parts))
+    for part, found in zip(parts, answers):
+        for i, one in zip(part, found):
+            for a, b in zip(one, batch):
+                np.testing.assert_array_equal(a[0], b[i])
+
+
 # The conversion of 1e200 to float32 for faiss warns before the error.
 @pytest.mark.filterwarnings("ignore:overflow encountered in cast:RuntimeWarning")
 def test_hnsw_one_query_names_nan_and_huge_values(walks):
