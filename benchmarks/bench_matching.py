@@ -140,29 +140,32 @@ def _graph_alone(index):
 
 
 def _cached_graph(features, cache):
-    """MotionMatcher's graph of ``features``: from ``cache`` if it holds this one, else built.
+    """MotionMatcher's graph of ``features`` and its row order: from ``cache`` if it holds them.
 
-    The cache is a faiss file with the SHA-256 of the float32 features beside it
-    (``.sha256``); a graph of other features is built again, and a new graph is
-    written under a temporary name and renamed, so the cache is never half-written.
+    The cache is a faiss file with the row order (``.order.npy``) and the SHA-256
+    of the float32 features (``.sha256``) beside it; a graph of other features is
+    built again, and a new graph is written under temporary names and renamed, the
+    stamp last, so the cache is never half-written.
     """
     import faiss
 
     data = np.ascontiguousarray(features, dtype=np.float32)
     digest = hashlib.sha256(data.tobytes()).hexdigest()
-    stamp = Path(f"{cache}.sha256") if cache else None
-    if cache and Path(cache).is_file() and stamp.is_file() and stamp.read_text() == digest:
-        index = faiss.read_index(str(cache))
-        if index.ntotal == len(data) and index.d == data.shape[1]:
+    stamp, order_file = Path(f"{cache}.sha256"), Path(f"{cache}.order.npy")
+    if cache and stamp.is_file() and stamp.read_text() == digest and order_file.is_file():
+        index, order = faiss.read_index(str(cache)), np.load(order_file)
+        if index.ntotal == len(data) == len(order) and index.d == data.shape[1]:
             print(f"  MotionMatcher's graph read from {cache}")
-            return index
-    index = hnsw_index(data, BUILD_THREADS)
+            return index, order
+    index, order = hnsw_index(data, BUILD_THREADS)
     if cache:
-        partial_path = f"{cache}.partial"
-        faiss.write_index(index, partial_path)
-        os.replace(partial_path, cache)
+        stamp.unlink(missing_ok=True)
+        faiss.write_index(index, f"{cache}.partial")
+        os.replace(f"{cache}.partial", cache)
+        np.save(f"{cache}.partial.npy", order)
+        os.replace(f"{cache}.partial.npy", order_file)
         stamp.write_text(digest)
-    return index
+    return index, order
 
 
 def _contenders(matcher, matcher_kw, *, graph_cache=None, decisive=False):
@@ -184,7 +187,7 @@ def _contenders(matcher, matcher_kw, *, graph_cache=None, decisive=False):
         m.features_, m.take_, m.frame_ = matcher.features_, matcher.take_, matcher.frame_
         if algorithm == "hnsw":
             # MotionMatcher's graph (its degree and beam) on two threads, to save time.
-            m._set_graph(_cached_graph(m.features_, graph_cache))
+            m._set_graph(*_cached_graph(m.features_, graph_cache))
         else:
             m._build()
         build = time.perf_counter() - start

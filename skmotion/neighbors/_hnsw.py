@@ -34,23 +34,56 @@ def faiss_module():
 
 
 def hnsw_index(data, threads=1):
-    """faiss's HNSW graph of the rows, by default on one thread: the same graph every time.
+    """faiss's HNSW graph of the rows, stored in cluster order; the order.
 
-    More threads build it faster, but the graph may then depend on their timing
-    (the benchmark uses two to save time; it is not an estimator parameter, as
-    skmotion's ``n_jobs`` promises results identical to one job's). faiss's
-    thread count is restored afterwards.
+    The graph is built on the rows as given, then its vectors and links are
+    renumbered so that rows of one k-means cluster (about ``ROWS_PER_CLUSTER``
+    rows each) lie together in memory: a search walks from a row to rows
+    near it, which then share cache lines and pages. On 968,573 frames of
+    walks (380 MB of vectors and links) this cut faiss's search from 66 to
+    49 µs of CPU per query at the same answers (docs/motion-matching.md).
+    Graph row ``r`` is row ``order[r]`` of ``data``.
+
+    By default on one thread: the same graph every time. More threads build it
+    faster, but the graph may then depend on their timing (the benchmark uses
+    two to save time; it is not an estimator parameter, as skmotion's
+    ``n_jobs`` promises results identical to one job's). faiss's thread count
+    is restored afterwards.
     """
     faiss = faiss_module()
+    data = np.ascontiguousarray(data, dtype=np.float32)
     index = faiss.IndexHNSWFlat(data.shape[1], HNSW_M)
     index.hnsw.efConstruction = HNSW_EF_CONSTRUCTION
     previous = faiss.omp_get_max_threads()
     faiss.omp_set_num_threads(threads)
     try:
-        index.add(np.ascontiguousarray(data, dtype=np.float32))
+        index.add(data)
+        order = cluster_order(data)
+        index.permute_entries(order)
     finally:
         faiss.omp_set_num_threads(previous)
-    return index
+    return index, order
+
+
+#: Rows per k-means cluster of the storage order: about 1,000 rows (380 kB of
+#: vectors and links at 30 dimensions) fit the processor's second-level cache.
+ROWS_PER_CLUSTER = 1000
+
+
+def cluster_order(data):
+    """Rows grouped by k-means cluster (faiss's, seeded), in their order within each.
+
+    Fewer than two clusters' worth of rows keep their order.
+    """
+    n_clusters = len(data) // ROWS_PER_CLUSTER
+    if n_clusters < 2:
+        return np.arange(len(data), dtype=np.int64)
+    faiss = faiss_module()
+    # Trained on 64 rows per centroid: the order needs neighbourhoods, not exact centres.
+    kmeans = faiss.Kmeans(data.shape[1], n_clusters, niter=8, seed=0, max_points_per_centroid=64)
+    kmeans.train(data)
+    _, cluster = kmeans.index.search(data, 1)
+    return np.argsort(cluster[:, 0], kind="stable").astype(np.int64)
 
 
 def faiss_search(index, X, k):

@@ -294,6 +294,7 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
     def _build(self):
         # A refit with another algorithm must not keep searching an earlier graph.
         self.__dict__.pop("_graph", None)
+        self.__dict__.pop("_graph_order", None)
         algorithm = "kd_tree" if self.algorithm == "auto" else self.algorithm
         data = self.features_
         if algorithm == "kd_tree":
@@ -301,15 +302,18 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         elif algorithm == "ball_tree":
             self.index_ = BallTree(data, leaf_size=self.leaf_size)
         elif algorithm == "hnsw":
-            self._set_graph(hnsw_index(data))
+            self._set_graph(*hnsw_index(data))
         else:
             self.index_ = None
             self.squared_norms_ = np.einsum("ij,ij->i", data, data)
 
-    def _set_graph(self, index):
-        """Keep an HNSW graph as the index, with its searches (not pickled: rebuilt on load)."""
-        self.index_ = index
-        self._graph = HnswSearch(index, self.take_, self.frame_)
+    def _set_graph(self, index, order):
+        """Keep an HNSW graph as the index, with its searches (not pickled: rebuilt on load).
+
+        Graph row ``r`` is row ``order[r]`` of ``features_`` (:func:`hnsw_index`).
+        """
+        self.index_, self._graph_order = index, order
+        self._graph = HnswSearch(index, self.take_[order], self.frame_[order])
 
     def frame_features(self, X):
         """The weighted, normalised feature of every frame of new takes.
@@ -396,7 +400,7 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         super().__setstate__(state)
         if graph:
             buffer = np.frombuffer(index[1], dtype=np.uint8)
-            self._set_graph(faiss_module().deserialize_index(buffer))
+            self._set_graph(faiss_module().deserialize_index(buffer), self._graph_order)
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()

@@ -139,7 +139,7 @@ def test_hnsw_graph_recall_on_a_made_up_cloud(threads):
     cloud += 0.05 * rng.normal(size=cloud.shape)
     data, queries = cloud[:5000], cloud[5000:]
     truth = np.sqrt(((queries[:, None] - data[None]) ** 2).sum(axis=2).min(axis=1))
-    index = hnsw_index(data, threads)
+    index, _ = hnsw_index(data, threads)
     recall = {}
     for ef in (1, EF_DEFAULT):
         index.hnsw.efSearch = ef
@@ -163,17 +163,26 @@ def test_hnsw_follows_ef_changes_after_fit(walks):
 
 
 @pytest.mark.parametrize("k", [1, 3])
-def test_hnsw_one_query_per_call_answers_as_the_batch(walks, k):
+def test_hnsw_one_query_per_call_answers_as_the_batch(walks, k, monkeypatch):
     # One row per call takes the fast path (no checks before the search, the answer
     # built from the labels directly); a batch takes the checked path. Same graph:
     # the same neighbours and the same distances, whatever the row's form.
     pytest.importorskip("faiss")
+    # Clusters of 100 rows: the graph's storage order is not the rows' here.
+    monkeypatch.setattr("skmotion.neighbors._hnsw.ROWS_PER_CLUSTER", 100)
     takes, new = walks
     matcher = MotionMatcher(algorithm="hnsw").fit(takes)
     rng = np.random.default_rng(0)
     queries = np.concatenate(matcher.frame_features(new))[::3]
     queries = np.vstack([queries, rng.normal(scale=2.0, size=(40, queries.shape[1]))])
     batch = matcher.kneighbors(queries, n_neighbors=k)
+    # The graph stores its rows in cluster order: the labels must still name the
+    # frame whose feature is at the reported distance.
+    row_of = {(t, f): i for i, (t, f) in enumerate(zip(matcher.take_, matcher.frame_))}
+    rows = np.vectorize(lambda t, f: row_of[t, f])(batch[0], batch[1])
+    by_label = np.linalg.norm(matcher.features_[rows] - queries[:, None, :], axis=2)
+    np.testing.assert_allclose(batch[2], by_label, rtol=1e-5, atol=1e-5)
+    assert not np.array_equal(matcher._graph_order, np.arange(len(matcher.take_)))
     forms = (
         lambda q: q,
         lambda q: q[None],
