@@ -22,7 +22,9 @@ higher one visits more neighbours per step; a PCA to 8-12 dimensions with
 an exact re-ranking of 8-16 candidates stayed below 0.98, and faiss's
 half-precision or 8-bit storage was both slower and less exact; on 10^6
 frames faiss's inverted lists (1,024 of them) needed more time than the
-graph for the same recall.
+graph for the same recall. The graph is stored in cluster order
+(:func:`~skmotion.neighbors._hnsw.hnsw_index`), which on 10^6 frames cut a
+query's cost by a quarter at the same answers.
 """
 
 import math
