@@ -40,8 +40,8 @@ def hnsw_index(data, threads=1):
     renumbered so that rows of one k-means cluster (about ``ROWS_PER_CLUSTER``
     rows each) lie together in memory: a search walks from a row to rows
     near it, which then share cache lines and pages. On 968,573 frames of
-    walks (380 MB of vectors and links) this cut faiss's search from 66 to
-    49 µs of CPU per query at the same answers (docs/motion-matching.md).
+    walks (380 MB of vectors and links) this cut faiss's search from 65.5 to
+    49.8 µs of CPU per query at the same answers (docs/motion-matching.md).
     Graph row ``r`` is row ``order[r]`` of ``data``.
 
     By default on one thread: the same graph every time. More threads build it
