@@ -12,7 +12,7 @@ so a weight says how much the group counts whatever its units.
 
 The search backends were chosen by measurement (benchmarks/bench_matching.py,
 docs/motion-matching.md): on 10^6 frames of 30-dimensional features sklearn's
-k-d tree answers one exact query 60 times faster than faiss's compiled brute
+k-d tree answers one exact query 45-58 times faster than faiss's compiled brute
 force, and faiss's HNSW graph (Malkov and Yashunin, 2018) answers
 approximately at recall@1 0.99 where hnswlib's graph of the same degree and
 construction beam reached 0.92; brute force stays available for checking.
