@@ -402,7 +402,10 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         super().__setstate__(state)
         if graph:
             buffer = np.frombuffer(index[1], dtype=np.uint8)
-            self._set_graph(faiss_module().deserialize_index(buffer), self._graph_order)
+            index = faiss_module().deserialize_index(buffer)
+            # Pickled before the graph had a storage order: its rows are in their own.
+            order = self.__dict__.get("_graph_order")
+            self._set_graph(index, np.arange(index.ntotal) if order is None else order)
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
