@@ -37,6 +37,7 @@ Needs the ``bench`` and ``ann`` extras (stumpy, tslearn, faiss-cpu).
 
 import argparse
 import dataclasses
+import hashlib
 import os
 import sys
 import time
@@ -48,24 +49,29 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _common import SHARED_DATA, write_results  # noqa: E402
+from _msrc12 import msrc12_takes  # noqa: E402
 
 from skmotion.datasets import make_walks  # noqa: E402
 from skmotion.io import Motion, as_motions, read_bvh  # noqa: E402
 from skmotion.kinematics import get_layout  # noqa: E402
 from skmotion.kinematics._layouts import layout_plan  # noqa: E402
 from skmotion.neighbors import MotionMatcher, find_occurrences  # noqa: E402
-from skmotion.neighbors._motion_matcher import _hnsw_index  # noqa: E402
+from skmotion.neighbors._hnsw import hnsw_index  # noqa: E402
 from skmotion.planning import follow_path  # noqa: E402
 from skmotion.preprocessing._position_frame import position_frame_features  # noqa: E402
 
-EFS = tuple(sorted({12, 16, 24, 32, 64, MotionMatcher().ef}))
+EFS = tuple(sorted({12, 16, 20, 24, 32, 64, MotionMatcher().ef}))
 HNSW_DEFAULT = f"skmotion MotionMatcher hnsw ef={MotionMatcher().ef}"
+#: faiss's compiled search alone on MotionMatcher's graph: what the wrapper adds is the difference.
+GRAPH_ALONE = "faiss search_c alone, MotionMatcher's graph ef={}"
 KD_TREE = "skmotion MotionMatcher kd_tree"
 #: Threads that build the HNSW graphs (skmotion's and faiss's); queries run on one.
 BUILD_THREADS = 2
 BRUTE = ("sklearn NearestNeighbors brute", "faiss IndexFlatL2")
 #: Unmeasured calls before each timing: the first calls fault pages in.
 WARM_UP = 20
+#: Queries per block when several methods are timed interleaved, block by block.
+BLOCK = 50
 #: Timings of the occurrence search (skmotion's and stumpy's), interleaved; the fastest kept.
 REPEATS = 3
 ZIGZAG = np.array([[0.0, 0.0], [1.0, 0.25], [2.0, -0.25], [3.0, 0.25], [4.0, 0.0]])
@@ -80,33 +86,95 @@ def _walks(n_frames, seed):
 
 def _msrc(fraction):
     """MSRC-12 sequences as (positions per sequence, person per sequence)."""
-    data = np.load(SHARED_DATA / "msrc12" / "msrc12_sequences.npz")
-    offsets, person = data["offsets"], data["person"]
-    n = int(round((len(offsets) - 1) * fraction))
-    seqs = [data["positions"][offsets[i] : offsets[i + 1]].astype(float) for i in range(n)]
+    seqs, _, _, person = msrc12_takes(SHARED_DATA / "msrc12" / "msrc12_sequences.npz")
+    n = int(round(len(seqs) * fraction))
     # A few sequences are empty (every frame untracked): they hold nothing to search.
     keep = [i for i in range(n) if len(seqs[i]) >= 2]
-    return [seqs[i] for i in keep], person[:n][keep]
+    return [seqs[i] for i in keep], person[keep]
 
 
-def _time_single(func, queries):
-    """Wall and CPU microseconds per call of ``func(one_query)``, over all queries; answers.
+def _time_single(funcs, queries):
+    """Wall and CPU microseconds per call of each ``func(one_query)``, over all queries; answers.
 
-    The CPU time is the process's: on a loaded machine it is closer to what a query
+    Several functions are timed interleaved, ``BLOCK`` queries of one, then of the
+    next (in turn first and last), so that a change in the machine's load falls on
+    all of them alike. The
+    CPU time is the process's: on a loaded machine it is closer to what a query
     costs alone than the wall time, which includes waiting for a core.
     """
-    for q in queries[:WARM_UP]:
-        func(q[None])
-    out = []
-    wall, cpu = time.perf_counter(), time.process_time()
-    for q in queries:
-        out.append(func(q[None]))
-    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
-    return wall / len(queries) * 1e6, cpu / len(queries) * 1e6, np.asarray(out)
+    for func in funcs:
+        for q in queries[:WARM_UP]:
+            func(q[None])
+    wall, cpu = np.zeros(len(funcs)), np.zeros(len(funcs))
+    out = [[] for _ in funcs]
+    for start in range(0, len(queries), BLOCK):
+        block = queries[start : start + BLOCK]
+        # Alternate who goes first: the second finds the block's graph nodes in cache.
+        order = range(len(funcs)) if start // BLOCK % 2 == 0 else reversed(range(len(funcs)))
+        for i in order:
+            func = funcs[i]
+            w, c = time.perf_counter(), time.process_time()
+            answers = [func(q[None]) for q in block]
+            wall[i] += time.perf_counter() - w
+            cpu[i] += time.process_time() - c
+            out[i] += answers
+    scale = 1e6 / len(queries)
+    return [(w * scale, c * scale, np.asarray(o)) for w, c, o in zip(wall, cpu, out)]
 
 
-def _contenders(matcher, matcher_kw):
-    """(label, build seconds, prepare, query function) of skmotion and every peer."""
+def _graph_alone(index):
+    """faiss's compiled search of one query on ``index``, buffers made once: no wrapper at all."""
+    import faiss
+
+    query = np.empty((1, index.d), dtype=np.float32)
+    squared, rows = np.empty((1, 1), dtype=np.float32), np.empty((1, 1), dtype=np.int64)
+    pointers = [faiss.swig_ptr(a) for a in (query, squared, rows)]
+    search = index.search_c
+
+    def func(q):
+        query[:] = q
+        search(1, pointers[0], 1, pointers[1], pointers[2])
+        return float(np.sqrt(squared[0, 0]))
+
+    return func
+
+
+def _cached_graph(features, cache):
+    """MotionMatcher's graph of ``features`` and its row order: from ``cache`` if it holds them.
+
+    The cache is a faiss file with the row order (``.order.npy``) and the SHA-256
+    of the float32 features (``.sha256``) beside it; a graph of other features is
+    built again, and a new graph is written under temporary names and renamed, the
+    stamp last, so the cache is never half-written.
+    """
+    import faiss
+
+    data = np.ascontiguousarray(features, dtype=np.float32)
+    digest = hashlib.sha256(data.tobytes()).hexdigest()
+    stamp, order_file = Path(f"{cache}.sha256"), Path(f"{cache}.order.npy")
+    if cache and stamp.is_file() and stamp.read_text() == digest and order_file.is_file():
+        index, order = faiss.read_index(str(cache)), np.load(order_file)
+        if index.ntotal == len(data) == len(order) and index.d == data.shape[1]:
+            print(f"  MotionMatcher's graph read from {cache}")
+            return index, order
+    index, order = hnsw_index(data, BUILD_THREADS)
+    if cache:
+        stamp.unlink(missing_ok=True)
+        faiss.write_index(index, f"{cache}.partial")
+        os.replace(f"{cache}.partial", cache)
+        np.save(f"{cache}.partial.npy", order)
+        os.replace(f"{cache}.partial.npy", order_file)
+        stamp.write_text(digest)
+    return index, order
+
+
+def _contenders(matcher, matcher_kw, *, graph_cache=None, decisive=False):
+    """(labels, build seconds, prepare, query functions) of skmotion and every peer.
+
+    A contender with several functions (MotionMatcher's graph through ``kneighbors``
+    and faiss's compiled search alone on the same graph) is timed interleaved.
+    ``decisive``: the k-d tree (the truth) and the default beam alone.
+    """
     import faiss
     from sklearn.neighbors import NearestNeighbors
 
@@ -119,24 +187,28 @@ def _contenders(matcher, matcher_kw):
         m.features_, m.take_, m.frame_ = matcher.features_, matcher.take_, matcher.frame_
         if algorithm == "hnsw":
             # MotionMatcher's graph (its degree and beam) on two threads, to save time.
-            m.index_, m._ef_set = _hnsw_index(m.features_, BUILD_THREADS), None
+            m._set_graph(*_cached_graph(m.features_, graph_cache))
         else:
             m._build()
         build = time.perf_counter() - start
         func = lambda q, m=m: m.kneighbors(q)[2][0, 0]  # noqa: E731
         if algorithm == "kd_tree":
-            out.append((KD_TREE, build, None, func))
+            out.append(((KD_TREE,), build, None, (func,)))
             continue
-        for ef in EFS:
+        alone = _graph_alone(m.index_)
+        for ef in (m.ef,) if decisive else EFS:
+            # kneighbors writes the beam into the graph; faiss alone then searches with it.
             prepare = partial(m.set_params, ef=ef)
-            out.append((f"skmotion MotionMatcher hnsw ef={ef}", build, prepare, func))
+            labels = (f"skmotion MotionMatcher hnsw ef={ef}", GRAPH_ALONE.format(ef))
+            out.append((labels, build, prepare, (func, alone)))
+    if decisive:
+        return out
     for algorithm in ("brute", "kd_tree", "ball_tree"):
         start = time.perf_counter()
         nn = NearestNeighbors(n_neighbors=1, algorithm=algorithm).fit(data)
         func = lambda q, nn=nn: nn.kneighbors(q)[0][0, 0]  # noqa: E731
-        out.append(
-            (f"sklearn NearestNeighbors {algorithm}", time.perf_counter() - start, None, func)
-        )
+        label = f"sklearn NearestNeighbors {algorithm}"
+        out.append(((label,), time.perf_counter() - start, None, (func,)))
     data32 = np.ascontiguousarray(data, dtype=np.float32)
     faiss.omp_set_num_threads(BUILD_THREADS)
     flat = faiss.IndexFlatL2(data.shape[1])
@@ -147,16 +219,17 @@ def _contenders(matcher, matcher_kw):
         build = time.perf_counter() - start
         func = lambda q, index=index: float(np.sqrt(index.search(q.astype(np.float32), 1)[0][0, 0]))  # noqa: E731
         if index is flat:
-            out.append(("faiss IndexFlatL2", build, None, func))
+            out.append((("faiss IndexFlatL2",), build, None, (func,)))
             continue
         for ef in EFS:
             prepare = partial(setattr, index.hnsw, "efSearch", ef)
-            out.append((f"faiss IndexHNSWFlat M=32 efSearch={ef}", build, prepare, func))
+            label = f"faiss IndexHNSWFlat M=32 efSearch={ef}"
+            out.append(((label,), build, prepare, (func,)))
     faiss.omp_set_num_threads(1)  # single queries on one thread, as the others
     return out
 
 
-def frame_search(name, matcher_kw, index_takes, query_takes, n_queries):
+def frame_search(name, matcher_kw, index_takes, query_takes, n_queries, **contenders_kw):
     """One table's rows: skmotion's exact and approximate search beside the peers."""
     started = time.perf_counter()
     # Brute force builds nothing: the features alone (each backend is built below).
@@ -166,18 +239,17 @@ def frame_search(name, matcher_kw, index_takes, query_takes, n_queries):
     pool = np.concatenate(matcher.frame_features(query_takes))
     queries = pool[rng.choice(len(pool), size=min(n_queries, len(pool)), replace=False)]
     timings = {}
-    for label, build, prepare, func in _contenders(matcher, matcher_kw):
+    for labels, build, prepare, funcs in _contenders(matcher, matcher_kw, **contenders_kw):
         if prepare is not None:
             prepare()
         # The brute-force scans are slow: a tenth of the queries is enough to time them.
-        slow = "brute" in label or "Flat" in label and "HNSW" not in label
+        slow = "brute" in labels[0] or "Flat" in labels[0] and "HNSW" not in labels[0]
         subset = queries[: max(20, len(queries) // 10)] if slow else queries
-        timings[label] = (build, *_time_single(func, subset))
-        print(
-            f"  {label}: {timings[label][1]:.1f} us wall, {timings[label][2]:.1f} us CPU per query"
-        )
-    # sklearn's k-d tree is exact: its answers are the truth (brute force agrees on its subset).
-    exact = timings["sklearn NearestNeighbors kd_tree"][3]
+        for label, timing in zip(labels, _time_single(funcs, subset)):
+            timings[label] = (build, *timing)
+            print(f"  {label}: {timing[0]:.1f} us wall, {timing[1]:.1f} us CPU per query")
+    # The k-d tree is exact (the tests check it against brute force): its answers are the truth.
+    exact = timings[KD_TREE][3]
     kd_cpu, hnsw_cpu = timings[KD_TREE][2], timings[HNSW_DEFAULT][2]
     rows = []
     for label, (build, wall, cpu, answers) in timings.items():
@@ -206,11 +278,14 @@ def _summary(rows):
     """The issue's test: the default HNSW beam and the exact mode against each peer."""
     by = {r["method"]: r for r in rows}
     ours, kd = by[HNSW_DEFAULT], by[KD_TREE]
+    alone = by[GRAPH_ALONE.format(MotionMatcher().ef)]
     met = ours["cpu_us_per_query"] <= 50 and ours["recall@1"] >= 0.99
     print(
         f"{rows[0]['data']}, {rows[0]['n_frames']} frames: {HNSW_DEFAULT}: "
         f"{ours['cpu_us_per_query']} us CPU ({ours['us_per_query']} us wall) per query at "
-        f"recall@1 {ours['recall@1']}: {'met' if met else 'NOT met'} (<= 50 us at >= 0.99)"
+        f"recall@1 {ours['recall@1']}: {'met' if met else 'NOT met'} (<= 50 us at >= 0.99); "
+        f"faiss's compiled search alone on the same graph: {alone['cpu_us_per_query']} us CPU "
+        f"(the wrapper: {ours['cpu_us_per_query'] - alone['cpu_us_per_query']:.1f} us)"
     )
     for label, row in by.items():
         if label != HNSW_DEFAULT:
@@ -218,11 +293,12 @@ def _summary(rows):
                 f"  CPU per query of {label} / ours: {row['cpu_ratio_to_hnsw']} "
                 f"(exact k-d tree: {row['cpu_ratio_to_kd_tree']}; recall@1 {row['recall@1']})"
             )
-    brute = min(by[m]["cpu_ratio_to_kd_tree"] for m in BRUTE)
-    print(
-        f"  exact mode (k-d tree, {kd['cpu_us_per_query']} us CPU): {brute}x faster than the "
-        f"faster brute force ({'met' if brute >= 10 else 'NOT met'}: >= 10x)"
-    )
+    if all(m in by for m in BRUTE):
+        brute = min(by[m]["cpu_ratio_to_kd_tree"] for m in BRUTE)
+        print(
+            f"  exact mode (k-d tree, {kd['cpu_us_per_query']} us CPU): {brute}x faster than "
+            f"the faster brute force ({'met' if brute >= 10 else 'NOT met'}: >= 10x)"
+        )
 
 
 def _brute_top(query, take, k, exclusion):
@@ -427,26 +503,37 @@ def main():
         default="frames,msrc-frames,occurrences,controller",
         help="comma-separated: frames, msrc-frames, occurrences, controller",
     )
+    parser.add_argument(
+        "--graph-cache",
+        help="faiss file for MotionMatcher's graph of the synthetic walks: read when it holds "
+        "the graph of these features, else built and written there",
+    )
+    parser.add_argument(
+        "--decisive",
+        action="store_true",
+        help="frames: the exact k-d tree, the default beam and faiss alone on its graph only",
+    )
     args = parser.parse_args()
     parts = set(args.parts.split(","))
     frames = 10**5 if args.quick else args.frames
     load = os.getloadavg()
     notes = f"load average at the start: {load[0]:.1f} / {load[1]:.1f} / {load[2]:.1f}"
-    have_msrc = (SHARED_DATA / "msrc12").is_dir()
+    have_msrc = (SHARED_DATA / "msrc12").is_dir() and parts & {"msrc-frames", "occurrences"}
     seqs, person = _msrc(0.2 if args.quick else 1.0) if have_msrc else ([], [])
-    if parts & {"frames", "msrc-frames"}:
-        rows = []
-        if "frames" in parts:
-            start = time.perf_counter()
-            index_takes, query_takes = _walks(frames, 0), _walks(max(frames // 50, 3000), 1)
-            print(f"walks generated in {time.perf_counter() - start:.1f} s")
-            rows += frame_search("synthetic walks", {}, index_takes, query_takes, args.queries)[0]
-        if have_msrc and "msrc-frames" in parts:
-            kw = {"layout": "kinect_v1", "frame_rate": 15.0, "points": ("left_hand", "right_hand")}
-            odd = [s for s, p in zip(seqs, person) if p % 2]
-            even = [s for s, p in zip(seqs, person) if not p % 2]
-            rows += frame_search("MSRC-12 (odd persons indexed)", kw, odd, even, args.queries)[0]
-        write_results("matching_frames", rows, notes=notes)
+    if "frames" in parts:
+        start = time.perf_counter()
+        index_takes, query_takes = _walks(frames, 0), _walks(max(frames // 50, 3000), 1)
+        print(f"walks generated in {time.perf_counter() - start:.1f} s")
+        kw = {"graph_cache": args.graph_cache, "decisive": args.decisive}
+        rows = frame_search("synthetic walks", {}, index_takes, query_takes, args.queries, **kw)
+        name = "matching_frames_decisive" if args.decisive else "matching_frames"
+        write_results(name, rows[0], notes=notes)
+    if have_msrc and "msrc-frames" in parts:
+        kw = {"layout": "kinect_v1", "frame_rate": 15.0, "points": ("left_hand", "right_hand")}
+        odd = [s for s, p in zip(seqs, person) if p % 2]
+        even = [s for s, p in zip(seqs, person) if not p % 2]
+        rows = frame_search("MSRC-12 (odd persons indexed)", kw, odd, even, args.queries)
+        write_results("matching_frames_msrc12", rows[0], notes=notes)
     if "occurrences" in parts:
         rows = []
         occurrences("synthetic take", _smooth_take(frames, 6, 0), frames // 3, 60, rows, False)

@@ -12,7 +12,7 @@ so a weight says how much the group counts whatever its units.
 
 The search backends were chosen by measurement (benchmarks/bench_matching.py,
 docs/motion-matching.md): on 10^6 frames of 30-dimensional features sklearn's
-k-d tree answers one exact query 60 times faster than faiss's compiled brute
+k-d tree answers one exact query 45-58 times faster than faiss's compiled brute
 force, and faiss's HNSW graph (Malkov and Yashunin, 2018) answers
 approximately at recall@1 0.99 where hnswlib's graph of the same degree and
 construction beam reached 0.92; brute force stays available for checking.
@@ -22,7 +22,9 @@ higher one visits more neighbours per step; a PCA to 8-12 dimensions with
 an exact re-ranking of 8-16 candidates stayed below 0.98, and faiss's
 half-precision or 8-bit storage was both slower and less exact; on 10^6
 frames faiss's inverted lists (1,024 of them) needed more time than the
-graph for the same recall.
+graph for the same recall. The graph is stored in cluster order
+(:func:`~skmotion.neighbors._hnsw.hnsw_index`), which on 10^6 frames cut a
+query's cost by a quarter at the same answers.
 """
 
 import math
@@ -37,6 +39,7 @@ from skmotion.base import VersionedStateMixin
 from skmotion.io import Motion
 from skmotion.kinematics import get_layout
 from skmotion.kinematics._layouts import layout_plan
+from skmotion.neighbors._hnsw import HnswSearch, faiss_module, hnsw_index
 from skmotion.planning._ik import plan_axes
 from skmotion.preprocessing._marker_presets import marker_preset
 from skmotion.preprocessing._position_frame import position_frame_features
@@ -47,10 +50,6 @@ __all__ = ["MotionMatcher", "floor_frames"]
 #: The facing pairs and the root, by shared marker name.
 _ROLES = {"root": ("pelvis",), "lefts": ("left_hip", "left_shoulder")}
 _ROLES["rights"] = tuple(name.replace("left", "right") for name in _ROLES["lefts"])
-#: HNSW graph degree and construction beam (docs/motion-matching.md, "Choosing the
-#: graph": on 2 x 10^5 frames degree 32 reached recall@1 0.99 at beam 16, degree 16
-#: not even at beam 32).
-HNSW_M, HNSW_EF_CONSTRUCTION = 32, 100
 #: HNSW search beam by default: recall@1 >= 0.99 on 10^6 frames of walks (the benchmark).
 EF_DEFAULT = 24
 
@@ -295,6 +294,9 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         return self
 
     def _build(self):
+        # A refit with another algorithm must not keep searching an earlier graph.
+        self.__dict__.pop("_graph", None)
+        self.__dict__.pop("_graph_order", None)
         algorithm = "kd_tree" if self.algorithm == "auto" else self.algorithm
         data = self.features_
         if algorithm == "kd_tree":
@@ -302,11 +304,18 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         elif algorithm == "ball_tree":
             self.index_ = BallTree(data, leaf_size=self.leaf_size)
         elif algorithm == "hnsw":
-            self.index_ = _hnsw_index(data)
-            self._ef_set = None
+            self._set_graph(*hnsw_index(data))
         else:
             self.index_ = None
             self.squared_norms_ = np.einsum("ij,ij->i", data, data)
+
+    def _set_graph(self, index, order):
+        """Keep an HNSW graph as the index, with its searches (not pickled: rebuilt on load).
+
+        Graph row ``r`` is row ``order[r]`` of ``features_`` (:func:`hnsw_index`).
+        """
+        self.index_, self._graph_order = index, order
+        self._graph = HnswSearch(index, self.take_[order], self.frame_[order])
 
     def frame_features(self, X):
         """The weighted, normalised feature of every frame of new takes.
@@ -341,6 +350,13 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
         distance : ndarray of shape (n_queries, n_neighbors)
             Euclidean, nearest first.
         """
+        graph = self.__dict__.get("_graph")
+        if graph is not None:
+            # One row, the motion-matching case: the graph answers it without the
+            # checks below (a NaN or inf makes its answer None, and they name it).
+            found = graph.one(X, n_neighbors, self.ef)
+            if found is not None:
+                return found
         if "features_" not in vars(self):
             # check_is_fitted's scan of the attributes costs as much as an approximate query.
             check_is_fitted(self)
@@ -362,33 +378,34 @@ class MotionMatcher(VersionedStateMixin, BaseEstimator):
             if not finite.all():
                 raise ValueError(f"query {int(np.flatnonzero(~finite)[0])} holds NaN or inf")
         k = min(int(n_neighbors), len(self.features_))
+        if graph is not None:
+            return graph.batch(X, k, self.ef)
         index = self.index_
-        if isinstance(index, (KDTree, BallTree)):
+        if index is not None:
             distance, index = index.query(X, k=k)
-        elif index is not None:
-            ef = max(self.ef, k)
-            if ef != self._ef_set:
-                # A SWIG attribute write costs microseconds: only when it changes.
-                index.hnsw.efSearch = self._ef_set = ef
-            distance, found = _faiss_search(index, X, k)
-            index = found
         else:
             distance, index = _brute_force(self.features_, self.squared_norms_, X, k)
         return self.take_[index], self.frame_[index], distance
 
     def __getstate__(self):
         state = super().__getstate__()
-        if not isinstance(state.get("index_"), (KDTree, BallTree, type(None))):
+        if state.pop("_graph", None) is not None:
             # faiss indexes do not pickle: their own serialisation, as bytes.
-            state["index_"] = ("faiss", _faiss().serialize_index(state["index_"]).tobytes())
+            state["index_"] = ("faiss", faiss_module().serialize_index(state["index_"]).tobytes())
         return state
 
     def __setstate__(self, state):
         index = state.get("index_")
-        if isinstance(index, tuple) and index[0] == "faiss":
-            buffer = np.frombuffer(index[1], dtype=np.uint8)
-            state = dict(state, index_=_faiss().deserialize_index(buffer), _ef_set=None)
+        graph = isinstance(index, tuple) and index[0] == "faiss"
+        if graph:
+            state = dict(state, index_=None)
         super().__setstate__(state)
+        if graph:
+            buffer = np.frombuffer(index[1], dtype=np.uint8)
+            index = faiss_module().deserialize_index(buffer)
+            # Pickled before the graph had a storage order: its rows are in their own.
+            order = self.__dict__.get("_graph_order")
+            self._set_graph(index, np.arange(index.ntotal) if order is None else order)
 
     def __sklearn_tags__(self):
         tags = super().__sklearn_tags__()
@@ -406,43 +423,3 @@ def _brute_force(data, squared_norms, X, k):
     index = np.take_along_axis(part, order, axis=1)
     distance = np.sqrt(np.maximum(np.take_along_axis(squared, index, axis=1), 0.0))
     return distance, index
-
-
-def _faiss_search(index, X, k):
-    """faiss's search without its Python wrapper's checks (done above): distances, rows."""
-    faiss = _faiss()
-    X = np.ascontiguousarray(X, dtype=np.float32)
-    squared = np.empty((len(X), k), dtype=np.float32)
-    rows = np.empty((len(X), k), dtype=np.int64)
-    index.search_c(len(X), faiss.swig_ptr(X), k, faiss.swig_ptr(squared), faiss.swig_ptr(rows))
-    np.maximum(squared, 0.0, out=squared)
-    return np.sqrt(squared, out=squared), rows
-
-
-def _faiss():
-    try:
-        import faiss
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise ImportError(
-            "algorithm='hnsw' needs faiss: pip install 'skmotion[ann]' (or faiss-cpu)"
-        ) from exc
-    return faiss
-
-
-def _hnsw_index(data, threads=1):
-    """faiss's HNSW graph of the rows, by default on one thread: the same graph every time.
-
-    More threads build it faster, but the graph may then depend on their timing
-    (the benchmark uses two to save time; it is not an estimator parameter, as
-    skmotion's ``n_jobs`` promises results identical to one job's).
-    """
-    faiss = _faiss()
-    index = faiss.IndexHNSWFlat(data.shape[1], HNSW_M)
-    index.hnsw.efConstruction = HNSW_EF_CONSTRUCTION
-    threads = faiss.omp_get_max_threads()
-    faiss.omp_set_num_threads(threads)
-    try:
-        index.add(np.ascontiguousarray(data, dtype=np.float32))
-    finally:
-        faiss.omp_set_num_threads(threads)
-    return index

@@ -131,18 +131,19 @@ def test_hnsw_graph_recall_on_a_made_up_cloud(threads):
     # of a noisy 10-dimensional plane in 30 dimensions, against brute force. The beam
     # matters here: one entry finds the nearest point for about 60 % of the queries.
     pytest.importorskip("faiss")
-    from skmotion.neighbors._motion_matcher import EF_DEFAULT, _faiss_search, _hnsw_index
+    from skmotion.neighbors._hnsw import faiss_search, hnsw_index
+    from skmotion.neighbors._motion_matcher import EF_DEFAULT
 
     rng = np.random.default_rng(0)
     cloud = rng.normal(size=(5500, 10)) @ rng.normal(size=(10, 30))
     cloud += 0.05 * rng.normal(size=cloud.shape)
     data, queries = cloud[:5000], cloud[5000:]
     truth = np.sqrt(((queries[:, None] - data[None]) ** 2).sum(axis=2).min(axis=1))
-    index = _hnsw_index(data, threads)
+    index, _ = hnsw_index(data, threads)
     recall = {}
     for ef in (1, EF_DEFAULT):
         index.hnsw.efSearch = ef
-        found = _faiss_search(index, queries, 1)[0][:, 0]
+        found = faiss_search(index, queries, 1)[0][:, 0]
         recall[ef] = np.mean(np.isclose(found, truth, rtol=1e-4))
     assert recall[1] < 0.8
     assert recall[EF_DEFAULT] >= 0.99
@@ -159,6 +160,93 @@ def test_hnsw_follows_ef_changes_after_fit(walks):
     # A beam as wide as the collection visits every reachable frame: exact.
     approx.set_params(ef=len(approx.features_))
     np.testing.assert_allclose(approx.kneighbors(queries)[2][:, 0], truth, rtol=1e-5, atol=1e-5)
+
+
+@pytest.mark.parametrize("k", [1, 3])
+def test_hnsw_one_query_per_call_answers_as_the_batch(walks, k, monkeypatch):
+    # One row per call takes the fast path (no checks before the search, the answer
+    # built from the labels directly); a batch takes the checked path. Same graph:
+    # the same neighbours and the same distances, whatever the row's form.
+    pytest.importorskip("faiss")
+    # Clusters of 100 rows: the graph's storage order is not the rows' here.
+    monkeypatch.setattr("skmotion.neighbors._hnsw.ROWS_PER_CLUSTER", 100)
+    takes, new = walks
+    matcher = MotionMatcher(algorithm="hnsw").fit(takes)
+    rng = np.random.default_rng(0)
+    queries = np.concatenate(matcher.frame_features(new))[::3]
+    queries = np.vstack([queries, rng.normal(scale=2.0, size=(40, queries.shape[1]))])
+    batch = matcher.kneighbors(queries, n_neighbors=k)
+    # The graph stores its rows in cluster order: the labels must still name the
+    # frame whose feature is at the reported distance.
+    row_of = {(t, f): i for i, (t, f) in enumerate(zip(matcher.take_, matcher.frame_))}
+    rows = np.vectorize(lambda t, f: row_of[t, f])(batch[0], batch[1])
+    by_label = np.linalg.norm(matcher.features_[rows] - queries[:, None, :], axis=2)
+    np.testing.assert_allclose(batch[2], by_label, rtol=1e-5, atol=1e-5)
+    assert not np.array_equal(matcher._graph_order, np.arange(len(matcher.take_)))
+    forms = (
+        lambda q: q,
+        lambda q: q[None],
+        lambda q: q.astype(np.float32),
+        lambda q: np.asfortranarray(np.tile(q, (2, 1)))[:1],
+    )
+    for i, q in enumerate(queries):
+        for form in forms:
+            one = matcher.kneighbors(form(q), n_neighbors=k)
+            for a, b in zip(one, batch):
+                assert a.shape == (1, k)
+                np.testing.assert_array_equal(a[0], b[i])
+    # A refit without the graph does not keep searching it.
+    matcher.set_params(algorithm="brute").fit(takes)
+    take, frame, _ = matcher.kneighbors(queries[0])
+    np.testing.assert_array_equal((take, frame), matcher.kneighbors(queries[:1], n_neighbors=1)[:2])
+    assert "_graph" not in vars(matcher)
+
+
+def test_hnsw_one_query_per_call_from_threads(walks):
+    # The single-row buffers are per thread: four threads asking one row per call at
+    # once each get the batch's answer for their own rows.
+    pytest.importorskip("faiss")
+    from concurrent.futures import ThreadPoolExecutor
+
+    takes, new = walks
+    matcher = MotionMatcher(algorithm="hnsw").fit(takes)
+    queries = np.concatenate(matcher.frame_features(new))
+    batch = matcher.kneighbors(queries, n_neighbors=2)
+
+    def ask(part):
+        return [matcher.kneighbors(queries[i], n_neighbors=2) for i in part]
+
+    parts = [range(j, len(queries), 4) for j in range(4)]
+    with ThreadPoolExecutor(4) as pool:
+        answers = list(pool.map(ask, parts))
+    for part, found in zip(parts, answers):
+        for i, one in zip(part, found):
+            for a, b in zip(one, batch):
+                np.testing.assert_array_equal(a[0], b[i])
+
+
+# The conversion of 1e200 to float32 for faiss warns before the error.
+@pytest.mark.filterwarnings("ignore:overflow encountered in cast:RuntimeWarning")
+def test_hnsw_one_query_names_nan_and_huge_values(walks):
+    # The fast path checks a row by its answer: a NaN or inf row must still be
+    # refused by name, and a finite row whose distances overflow float32 (faiss
+    # then finds no neighbour, row -1) refused as the batch refuses it, not
+    # labelled with the last frame.
+    pytest.importorskip("faiss")
+    takes, _ = walks
+    matcher = MotionMatcher(algorithm="hnsw").fit(takes)
+    for bad in (np.nan, np.inf, -np.inf):
+        row = matcher.features_[0].copy()
+        row[5] = bad
+        with pytest.raises(ValueError, match="query 0 holds NaN or inf"):
+            matcher.kneighbors(row)
+        with pytest.raises(ValueError, match="query 0 holds NaN or inf"):
+            matcher.kneighbors(row[None], n_neighbors=2)
+    huge = np.full(matcher.features_.shape[1], 1e200)
+    with pytest.raises(ValueError, match="query 0: fewer than 1 neighbours found"):
+        matcher.kneighbors(huge)
+    with pytest.raises(ValueError, match="query 1: fewer than 1 neighbours found"):
+        matcher.kneighbors(np.vstack([matcher.features_[:1], huge]))
 
 
 def test_huge_finite_queries_are_not_refused(walks):
