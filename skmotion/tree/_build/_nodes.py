@@ -269,23 +269,17 @@ class _Builder:
         if axis is None:
             return result
         proj = project_rows(block, axis)  # as routing computes it
-        n_left, thr = self.cut(proj)
+        n_left, thr = cut_projections(proj, self.split, self.min_leaf, self.tol)
         if n_left is None:
             return result
         index = None if self.index is None else self.index[start:stop]
         if partition_rows(block, proj, thr, index) != n_left:  # pragma: no cover - a bug
             raise RuntimeError(f"node {node}: the cut does not separate {n_left} frames.")
         result.update(axis=axis, thr=thr, n_left=n_left)
-        kept = self.kept_scatter(scatter, raw, n, d)
+        kept = kept_scatter(scatter, raw, n, d, self.kind)
         if kept is not None:
             result["keep"] = kept
         return result
-
-    def cut(self, proj):
-        return cut_projections(proj, self.split, self.min_leaf, self.tol)
-
-    def kept_scatter(self, scatter, raw, n, d):
-        return kept_scatter(scatter, raw, n, d, self.kind)
 
     def process_family(self, family, may_split):
         """``process`` of a node or of two siblings: the one with fewer rows first, whose
