@@ -41,7 +41,7 @@ from skmotion.tree._build._nodes import (
 )
 from skmotion.tree._build._out_of_core import _Nodes
 from skmotion.tree._build._permute import scatter_rows
-from skmotion.tree._build._standardise import standardise_in_place
+from skmotion.tree._build._standardise import carried_sum, standardise_in_place
 from skmotion.tree._gaussian import estimate_covariance
 
 __all__ = ["build_from_clips"]
@@ -97,12 +97,15 @@ def _stream_root(stacked, params):
     """The root's Gaussian, axis and cut, as ``_Builder.process`` makes them over the
     stacked frames, from three passes over the clips; and each frame's place in its child."""
     n, d = stacked.n_frames, stacked.n_channels
-    total, high, low = None, -np.inf, np.inf
-    for _, view in stacked.blocks(PROJECT_ROWS, spare_row=True):
-        high, low = max(high, float(view[1:].max())), min(low, float(view[1:].min()))
-        if total is not None:
-            view[0] = total
-        total = np.add.reduce(view if total is not None else view[1:], axis=0)
+    extremes = []  # each block's largest and smallest value: the gap resolution's range
+
+    def noting_extremes(pairs):
+        for pair in pairs:
+            extremes.append((float(pair[1][1:].max()), float(pair[1][1:].min())))
+            yield pair
+
+    total = carried_sum(noting_extremes(stacked.blocks(PROJECT_ROWS, spare_row=True)))
+    high, low = max(e[0] for e in extremes), min(e[1] for e in extremes)
     shift = total / n  # block.mean(axis=0) of the stacked frames
     out = (np.zeros(d), np.zeros((d, d)))
     chunk = moment_chunk_rows(d)  # blocks of whole chunks, about PROJECT_ROWS rows

@@ -10,7 +10,7 @@ into the next block as its first row gives the sums of the whole array exactly.
 
 import numpy as np
 
-__all__ = ["StackedClips", "column_mean_std", "standardise_in_place"]
+__all__ = ["StackedClips", "carried_sum", "column_mean_std", "standardise_in_place"]
 
 _BLOCK_ROWS = 1 << 15
 
@@ -138,8 +138,8 @@ class StackedClips:
         channels or more (NumPy sums a single column pairwise, not row after row)."""
         center, self.center = self.center, None
         try:
-            mean = _carried_sum(self.blocks(_BLOCK_ROWS, spare_row=True)) / self.n_frames
-            squares = _carried_sum(
+            mean = carried_sum(self.blocks(_BLOCK_ROWS, spare_row=True)) / self.n_frames
+            squares = carried_sum(
                 _centred(block, mean) for block in self.blocks(_BLOCK_ROWS, spare_row=True)
             )
         finally:
@@ -154,7 +154,7 @@ def _centred(pair, mean):
     return start, view
 
 
-def _carried_sum(pairs):
+def carried_sum(pairs):
     """The column sums of consecutive blocks (each with a spare first row) as NumPy sums
     the rows of one array: row after row, the running sums carried into the next block."""
     total = None
