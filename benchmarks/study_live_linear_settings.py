@@ -67,6 +67,9 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--subsample", type=int, default=1, help="every n-th training take")
     parser.add_argument("--candidates", nargs="+", required=True, help="JSON parameter dicts")
+    parser.add_argument(
+        "--output", default="live_linear_settings", help="results table (two studies at once)"
+    )
     args = parser.parse_args()
     takes, aps, gestures, people = msrc12()
     train = np.flatnonzero(people % 2 == 1)[:: args.subsample]
@@ -86,7 +89,7 @@ def main():
         )
         print(rows[-1], flush=True)
     write_results(
-        "live_linear_settings",
+        args.output,
         rows,
         notes="MSRC-12 training people only (odd ids), GroupKFold(3) over them.",
     )
