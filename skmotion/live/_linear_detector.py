@@ -194,6 +194,8 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         Its weights on the raw log-probabilities: ``[l, d, c]`` weighs class
         ``d``'s log-probability ``l * context_step`` frames back for class ``c``.
     context_bias_ : ndarray of shape (n_classes,) or None
+    context_mean_, context_scale_ : ndarray of shape (context_lags * n_classes,) or None
+        The standardisation of the second readout's inputs.
     classes_ : ndarray
         The classes, ``none_label`` among them.
     none_index_ : int
@@ -447,7 +449,8 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         scores the fold's takes at every frame, so that the second readout
         learns from probabilities as wrong as those of takes it never saw.
         """
-        self.context_weights_ = self.context_bias_ = self.context_classifier_ = None
+        self.context_classifier_ = self.context_weights_ = self.context_bias_ = None
+        self.context_mean_ = self.context_scale_ = None
         if not self.context_lags:
             return
         lags = self.context_step * np.arange(self.context_lags)
@@ -473,7 +476,8 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
                     )
                 rows[i] = lagged(_clipped_log(proba, self.window - 1), ends[i], lags)
         found = _readout(np.vstack(rows), np.concatenate(targets), self.context_C, self.none_label)
-        self.context_classifier_, _, _, coef, self.context_bias_ = found
+        self.context_classifier_, self.context_mean_, self.context_scale_ = found[:3]
+        coef, self.context_bias_ = found[3:]
         n_classes = len(self.classes_)
         self.context_weights_ = np.ascontiguousarray(
             coef.T.reshape(len(lags), n_classes, n_classes)

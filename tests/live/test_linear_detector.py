@@ -274,3 +274,99 @@ def test_hard_negatives_are_the_highest_scored_windows_away_from_positives(fitte
     again = np.delete(after, hard.none_index_, axis=1).max(axis=1)
     assert np.mean(again[chosen]) < np.mean(score[chosen])
     assert detection_f1(points[4:], labels[4:], hard.detect(takes[4:]), latency=6) == 1.0
+
+
+@pytest.fixture(scope="module")
+def with_context(fitted, skeleton_takes):
+    takes, points, labels = skeleton_takes
+    detector = clone(fitted).set_params(context_lags=4, context_step=3)
+    return detector.fit(takes[:4], labels[:4], action_points=points[:4])
+
+
+def test_the_context_readout_equals_a_brute_force_reference(with_context, skeleton_takes):
+    """The second readout by hand: the first readout's probabilities of every window
+    (brute force), their logs clipped at 1e-12 (zeros before the first full window and
+    before the take's start), picked 0, 3, 6 and 9 frames back, then the classifier."""
+    take = skeleton_takes[0][4]
+    d = with_context
+    first = np.zeros((len(take), len(d.classes_)))
+    first[d.window - 1 :] = np.log(np.maximum(brute_force_proba(d, take), 1e-12))
+    rows = [
+        np.concatenate([first[t - lag] if t >= lag else np.zeros(3) for lag in (0, 3, 6, 9)])
+        for t in range(d.window - 1, len(take))
+    ]
+    expected = d.context_classifier_.predict_proba(
+        (np.array(rows) - d.context_mean_) / d.context_scale_
+    )
+    ((ends, proba),) = d.scores([take])
+    np.testing.assert_array_equal(ends, np.arange(d.window - 1, len(take)))
+    np.testing.assert_allclose(proba, expected, rtol=1e-9, atol=1e-12)
+    assert d.context_weights_.shape == (4, 3, 3)
+    # it is not the first readout's: the context moved the probabilities
+    ((_, alone),) = (
+        clone(d)
+        .set_params(context_lags=0)
+        .fit(skeleton_takes[0][:4], skeleton_takes[2][:4], action_points=skeleton_takes[1][:4])
+        .scores([take])
+    )
+    assert np.abs(proba - alone).max() > 0.05
+    assert (
+        detection_f1(
+            skeleton_takes[1][4:], skeleton_takes[2][4:], d.detect(skeleton_takes[0][4:]), latency=6
+        )
+        == 1.0
+    )
+
+
+def test_the_context_readout_learns_from_out_of_fold_probabilities(
+    with_context, skeleton_takes, monkeypatch
+):
+    """Each fold's first readout is trained on the other takes' windows only (spied), and
+    the second readout's rows of a take come from the fold that did not see it."""
+    from skmotion.live import _linear_detector
+
+    calls = []
+    original = _linear_detector._readout
+
+    def spy(means, targets, C, none_label):
+        calls.append(len(means))
+        return original(means, targets, C, none_label)
+
+    monkeypatch.setattr(_linear_detector, "_readout", spy)
+    takes, points, labels = skeleton_takes
+    clone(with_context).fit(takes[:4], labels[:4], action_points=points[:4])
+    # the first readout on all windows, three folds (takes {0, 1}, {2}, {3} held out) on
+    # the others' windows, and the second readout on all windows again
+    total = calls[0]
+    assert len(calls) == 5 and calls[-1] == total
+    assert all(n < total for n in calls[1:4])
+
+
+@pytest.mark.parametrize("chunk", [1, 7, 1000])
+def test_the_context_stream_equals_the_batch_to_the_bit(with_context, skeleton_takes, chunk):
+    take = np.concatenate(skeleton_takes[0][4:])
+    ((_, proba),) = with_context.scores([take])
+    (batch,) = with_context.detect([take])
+    assert len(batch) >= 5
+    stream = with_context.stream()
+    streamed = [e for s in range(0, len(take), chunk) for e in stream.update(take[s : s + chunk])]
+    assert streamed == batch
+    np.testing.assert_array_equal(stream.last_proba, proba[-1])
+    stream.reset()
+    assert [e for frame in take for e in stream.update(frame)] == batch
+    with pytest.raises(ValueError, match="frame 2 holds NaN"):
+        with_context.stream().update(np.vstack([take[:2], np.full((1, 12), np.nan)]))
+
+
+def test_the_context_stream_memory_does_not_grow(with_context, skeleton_takes):
+    long_take = np.tile(skeleton_takes[0][0], (40, 1))  # about 12,000 frames
+    stream = with_context.stream()
+    for frame in long_take[:1000]:
+        stream.update(frame)
+    gc.collect()
+    before = sys.getallocatedblocks()
+    for frame in long_take[1000:]:
+        stream.update(frame)
+    gc.collect()
+    assert sys.getallocatedblocks() - before < 20
+    assert stream._history.shape == (10, 3)  # the lags' frames, 0 to 9 back
