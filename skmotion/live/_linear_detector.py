@@ -614,11 +614,13 @@ class LinearDetectorStream:
         )
         taken = n if bad < 0 else bad
         if self._context is not None:
-            lags, weights, bias, none = self._context
-            context_scores(
-                first[0][:taken], first[1][:taken], self._history, self.n_frames, lags, weights,
-                bias, none, proba[:taken], score[:taken], best[:taken],
+            # the frames taken before a bad one (their rows: views, made only then)
+            rows = (*first[:2], proba, score, best) if bad < 0 else (
+                first[0][:taken], first[1][:taken], proba[:taken], score[:taken], best[:taken]
             )  # fmt: skip
+            context_scores(
+                rows[0], rows[1], self._history, self.n_frames, *self._context, *rows[2:]
+            )
         self.n_frames += taken
         if bad >= 0:
             raise ValueError(f"update: frame {self.n_frames} holds NaN or infinity.")
