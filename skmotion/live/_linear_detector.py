@@ -13,7 +13,7 @@ from sklearn.utils.validation import check_is_fitted
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.live._detector import training_takes
 from skmotion.live._events import TRIGGERS, TriggerState, maximum_step, next_events
-from skmotion.live._window_kernel import context_scores, frame_features, window_scores
+from skmotion.live._window_kernel import frame_features, window_scores
 from skmotion.live._windows import training_ends
 from skmotion.utils._clips import check_clips
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
@@ -40,46 +40,6 @@ def segment_means(features, ends, n_segments, segment):
             for k in range(n_segments)
         ]
     )
-
-
-CONTEXT_FOLDS = 3  # folds of training takes for the second readout's out-of-fold inputs
-
-
-def _clipped_log(proba, first):
-    """``log(max(p, 1e-12))`` of each frame's probabilities, zeros before frame ``first`` (no
-    full window yet): the second readout's inputs, as :func:`context_scores` computes them."""
-    out = np.log(np.maximum(proba, 1e-12))
-    out[:first] = 0.0
-    return out
-
-
-def lagged(log_proba, ends, lags):
-    """Per end ``t``: the rows ``t - lag`` of ``log_proba`` for each lag side by side (zeros
-    before the take's start).
-
-    Returns
-    -------
-    rows : ndarray of shape (len(ends), len(lags) * log_proba.shape[1])
-    """
-    padded = np.vstack([np.zeros((int(max(lags)), log_proba.shape[1])), log_proba])
-    at = np.asarray(ends)[:, None] - np.asarray(lags)[None, :] + int(max(lags))
-    return padded[at].reshape(len(at), -1)
-
-
-def _readout(means, targets, C, none_label):
-    """A logistic regression on standardised ``means``; returns it, the standardisation, and
-    its coefficients and intercepts on the raw means (one row per class, also for two)."""
-    # StandardScaler leaves constant columns (up to rounding: a root joint) unscaled
-    scaler = StandardScaler().fit(means)
-    classifier = LogisticRegression(C=C, max_iter=3000)
-    classifier.fit((means - scaler.mean_) / scaler.scale_, targets)
-    if none_label not in classifier.classes_:
-        raise ValueError(f"no window of the rejection class {none_label!r}: raise n_negatives.")
-    coef, intercept = classifier.coef_, classifier.intercept_
-    if len(classifier.classes_) == 2:  # binary: predict_proba is the softmax of (0, decision)
-        coef, intercept = np.vstack([np.zeros_like(coef), coef]), np.r_[0.0, intercept]
-    coef = coef / scaler.scale_
-    return classifier, scaler.mean_, scaler.scale_, coef, intercept - coef @ scaler.mean_
 
 
 class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
@@ -156,17 +116,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     negative_gap : int, default=1
         A negative window ends more than this many frames from every positive
         window's end.
-    context_lags : int, default=0
-        A second readout, a logistic regression on the first readout's
-        log-probabilities (clipped at ``1e-12``) of this many windows, ending
-        ``0, context_step, 2 * context_step, ...`` frames back: a longer
-        context than the window, at ``context_lags x n_classes x n_classes``
-        products per frame. It learns from out-of-fold first-readout
-        probabilities (three folds of the training takes). 0: none.
-    context_step : int, default=2
-        Frames between two lags of the second readout.
-    context_C : float, default=0.01
-        Inverse regularisation of the second readout (on standardised inputs).
     none_label : str, default="none"
         The rejection class.
     random_state : int, RandomState instance or None, default=None
@@ -188,14 +137,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         The readout per frame and segment: a frame feature times
         ``weights_[k]`` is that frame's part of the decision when it lies in segment ``k``.
     bias_ : ndarray of shape (n_classes,)
-    context_classifier_ : LogisticRegression or None
-        The second readout (None when ``context_lags=0``).
-    context_weights_ : ndarray of shape (context_lags, n_classes, n_classes) or None
-        Its weights on the raw log-probabilities: ``[l, d, c]`` weighs class
-        ``d``'s log-probability ``l * context_step`` frames back for class ``c``.
-    context_bias_ : ndarray of shape (n_classes,) or None
-    context_mean_, context_scale_ : ndarray of shape (context_lags * n_classes,) or None
-        The standardisation of the second readout's inputs.
     classes_ : ndarray
         The classes, ``none_label`` among them.
     none_index_ : int
@@ -245,9 +186,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         "n_negatives": [Interval(Integral, 0, None, closed="left")],
         "hard_negatives": [Interval(Integral, 0, None, closed="left")],
         "negative_gap": [Interval(Integral, 0, None, closed="left")],
-        "context_lags": [Interval(Integral, 0, None, closed="left")],
-        "context_step": [Interval(Integral, 1, None, closed="left")],
-        "context_C": [Interval(Real, 0, None, closed="neither")],
         "none_label": [str],
         "random_state": ["random_state"],
     }
@@ -270,9 +208,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         n_negatives=80,
         hard_negatives=0,
         negative_gap=1,
-        context_lags=0,
-        context_step=2,
-        context_C=0.01,
         none_label="none",
         random_state=None,
     ):
@@ -290,9 +225,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         self.n_negatives = n_negatives
         self.hard_negatives = hard_negatives
         self.negative_gap = negative_gap
-        self.context_lags = context_lags
-        self.context_step = context_step
-        self.context_C = context_C
         self.none_label = none_label
         self.random_state = random_state
 
@@ -400,7 +332,6 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
             )
         features = [self._features(c) for c in clips]
         means = [segment_means(f, e, self.n_segments, self.segment) for f, e in zip(features, ends)]
-        self.context_weights_ = None  # the first readout alone scores the hard negatives
         self._fit_readout(np.vstack(means), np.concatenate(targets))
         if self.hard_negatives:
             # a second round: the windows the first readout scores highest away from every
@@ -408,13 +339,9 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
             # join the rejection class
             for k, (clip, f, positive) in enumerate(zip(clips, features, moved)):
                 hard = self._hard_ends(clip, positive, ends[k])
-                ends[k] = np.r_[ends[k], hard]
-                means[k] = np.vstack(
-                    [means[k], segment_means(f, hard, self.n_segments, self.segment)]
-                )
-                targets[k] = np.r_[targets[k], np.full(len(hard), self.none_label, dtype=object)]
+                means.append(segment_means(f, hard, self.n_segments, self.segment))
+                targets.append(np.full(len(hard), self.none_label, dtype=object))
             self._fit_readout(np.vstack(means), np.concatenate(targets))
-        self._fit_context(means, targets, features, ends)
         return self
 
     def _hard_ends(self, clip, positive, taken):
@@ -431,56 +358,26 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
 
     def _fit_readout(self, means, targets):
         """The logistic regression on standardised segment means, and its per-frame weights."""
-        found = _readout(means, targets, self.C, self.none_label)
-        self.classifier_, self.mean_, self.scale_, coef, self.bias_ = found
-        self.classes_ = self.classifier_.classes_
-        self.none_index_ = int(np.flatnonzero(self.classes_ == self.none_label)[0])
+        # StandardScaler leaves constant columns (up to rounding: a root joint) unscaled
+        scaler = StandardScaler().fit(means)
+        self.mean_, self.scale_ = scaler.mean_, scaler.scale_
+        classifier = LogisticRegression(C=self.C, max_iter=3000)
+        self.classifier_ = classifier.fit((means - self.mean_) / self.scale_, targets)
+        self.classes_ = classifier.classes_
+        found = np.flatnonzero(self.classes_ == self.none_label)
+        if not len(found):
+            raise ValueError(
+                f"no window of the rejection class {self.none_label!r}: raise n_negatives."
+            )
+        self.none_index_ = int(found[0])
+        coef, intercept = classifier.coef_, classifier.intercept_
+        if len(self.classes_) == 2:  # binary: predict_proba is the softmax of (0, decision)
+            coef, intercept = np.vstack([np.zeros_like(coef), coef]), np.r_[0.0, intercept]
+        coef = coef / self.scale_
+        self.bias_ = intercept - coef @ self.mean_
         n_features = 2 * self.n_features_in_ + len(self.poses_)
         self.weights_ = np.ascontiguousarray(
-            (coef / self.segment).T.reshape(self.n_segments, n_features, len(coef))
-        )
-
-    def _fit_context(self, means, targets, features, ends):
-        """The second readout: on out-of-fold first-readout log-probabilities at the lags.
-
-        Per training take: its windows' segment ``means``, their ``targets``,
-        its frame ``features`` and the windows' ``ends``. The first readout of
-        each of ``CONTEXT_FOLDS`` folds of takes (trained on the other takes)
-        scores the fold's takes at every frame, so that the second readout
-        learns from probabilities as wrong as those of takes it never saw.
-        """
-        self.context_classifier_ = self.context_weights_ = self.context_bias_ = None
-        self.context_mean_ = self.context_scale_ = None
-        if not self.context_lags:
-            return
-        lags = self.context_step * np.arange(self.context_lags)
-        rows = [None] * len(means)
-        for held in np.array_split(np.arange(len(means)), min(CONTEXT_FOLDS, len(means))):
-            others = np.setdiff1d(np.arange(len(means)), held)
-            others = others if len(others) else held  # one take: its in-sample probabilities
-            found = _readout(
-                np.vstack([means[i] for i in others]),
-                np.concatenate([targets[i] for i in others]),
-                self.C,
-                self.none_label,
-            )
-            classifier, mean, scale = found[:3]
-            columns = np.searchsorted(self.classes_, classifier.classes_)
-            for i in held:
-                every = np.arange(self.window - 1, len(features[i]))
-                window_means = segment_means(features[i], every, self.n_segments, self.segment)
-                proba = np.zeros((len(features[i]), len(self.classes_)))
-                if len(every):
-                    proba[np.ix_(every, columns)] = classifier.predict_proba(
-                        (window_means - mean) / scale
-                    )
-                rows[i] = lagged(_clipped_log(proba, self.window - 1), ends[i], lags)
-        found = _readout(np.vstack(rows), np.concatenate(targets), self.context_C, self.none_label)
-        self.context_classifier_, self.context_mean_, self.context_scale_ = found[:3]
-        coef, self.context_bias_ = found[3:]
-        n_classes = len(self.classes_)
-        self.context_weights_ = np.ascontiguousarray(
-            coef.T.reshape(len(lags), n_classes, n_classes)
+            (coef / self.segment).T.reshape(self.n_segments, n_features, len(self.classes_))
         )
 
     def stream(self):
@@ -580,12 +477,6 @@ class LinearDetectorStream:
         self._feature = np.zeros(d.weights_.shape[1])
         self._one = (np.zeros((1, n_classes)), np.zeros(1), np.zeros(1, dtype=np.intp))
         self.last_proba = self._one[0][0]
-        self._context = None
-        if getattr(d, "context_weights_", None) is not None:
-            lags = d.context_step * np.arange(d.context_lags, dtype=np.intp)
-            self._history = np.zeros((lags[-1] + 1, n_classes))  # the last frames' inputs
-            self._context = (lags, d.context_weights_, d.context_bias_, d.none_index_)
-            self._first = (np.zeros((1, n_classes)), np.zeros(1), np.zeros(1, dtype=np.intp))
         self.reset()
 
     def reset(self):
@@ -594,36 +485,23 @@ class LinearDetectorStream:
         self._state = TriggerState()
         self._ring[:] = 0.0
         self.last_proba[:] = 0.0
-        if self._context is not None:
-            self._history[:] = 0.0
 
     def _score(self, frames, out=None):
-        """The compiled update over ``frames``: per frame, probabilities, best score and class
-        (of the second readout when there is one)."""
+        """The compiled update over ``frames``: per frame, probabilities, best score and class."""
         n = len(frames)
-
-        def buffers():
-            return np.zeros((n, len(self._classes))), np.empty(n), np.empty(n, np.intp)
-
-        proba, score, best = out or buffers()
-        first = proba, score, best
-        if self._context is not None:  # the first readout's rows go to the second
-            first = self._first if out is not None else buffers()
-        bad = window_scores(
-            frames, self._previous, self._feature, self._ring, self.n_frames, *self._args, *first
+        proba, score, best = out or (
+            np.zeros((n, len(self._classes))),
+            np.empty(n),
+            np.empty(n, np.intp),
         )
-        taken = n if bad < 0 else bad
-        if self._context is not None:
-            # the frames taken before a bad one (their rows: views, made only then)
-            rows = (*first[:2], proba, score, best) if bad < 0 else (
-                first[0][:taken], first[1][:taken], proba[:taken], score[:taken], best[:taken]
-            )  # fmt: skip
-            context_scores(
-                rows[0], rows[1], self._history, self.n_frames, *self._context, *rows[2:]
-            )
-        self.n_frames += taken
+        bad = window_scores(
+            frames, self._previous, self._feature, self._ring, self.n_frames, *self._args,
+            proba, score, best,
+        )  # fmt: skip
         if bad >= 0:
+            self.n_frames += bad
             raise ValueError(f"update: frame {self.n_frames} holds NaN or infinity.")
+        self.n_frames += n
         return proba, score, best
 
     def update(self, frames):

@@ -21,7 +21,7 @@ the previous frame (a velocity; zero at a stream's first frame).
 
 import numpy as np
 
-from libc.math cimport INFINITY, exp, isfinite, log, sqrt
+from libc.math cimport INFINITY, exp, isfinite, sqrt
 
 
 cdef inline void _soft_poses(const double *pose, Py_ssize_t n_channels, const double *poses,
@@ -193,63 +193,3 @@ def window_scores(const double[:, ::1] frames, double[::1] previous, double[::1]
     # the GIL is kept: a call is a frame or a take of a few microseconds of work per frame
     return _window_scores(frames, previous, feature, ring, seen, weights, bias, root, size_a,
                           size_b, poses, width, segment, none_index, proba, score, best)
-
-
-def context_scores(const double[:, ::1] first, const double[::1] first_score,
-                   double[:, ::1] history, Py_ssize_t seen, const Py_ssize_t[::1] lags,
-                   const double[:, :, ::1] weights, const double[::1] bias,
-                   Py_ssize_t none_index, double[:, ::1] proba, double[::1] score,
-                   Py_ssize_t[::1] best):
-    """The second readout, on the first readout's log-probabilities at ``lags`` frames back.
-
-    ``first`` (n_frames, n_classes) and ``first_score``: :func:`window_scores`'
-    output for these frames (a negative score: no full window yet, whose
-    log-probabilities count as zeros, as do those before the stream's start).
-    ``history`` (max(lags) + 1, n_classes) holds the last frames' clipped
-    log-probabilities (``log(max(p, 1e-12))``), a ring indexed by frame modulo
-    its length; ``seen`` is the frames before these. ``weights`` (n_lags,
-    n_classes, n_classes): row ``[l, c]`` weighs class ``c``'s log-probability
-    ``lags[l]`` frames back. Rows of ``proba``, ``score`` and ``best`` as for
-    :func:`window_scores` (``score = -1``, ``proba`` untouched, before the first full window).
-    """
-    cdef Py_ssize_t n = first.shape[0], n_cls = first.shape[1], depth = history.shape[0]
-    cdef Py_ssize_t n_lags = lags.shape[0], t, s, l, c, d, slot
-    cdef double top, total, w, p
-    cdef const double *weight
-    cdef double *past
-    with nogil:
-        for t in range(n):
-            s = seen + t
-            slot = s % depth
-            for c in range(n_cls):
-                p = first[t, c]
-                history[slot, c] = 0.0 if first_score[t] < 0 else log(p if p > 1e-12 else 1e-12)
-            score[t] = -1.0
-            best[t] = -1
-            if first_score[t] < 0:
-                continue
-            for c in range(n_cls):
-                proba[t, c] = bias[c]
-            for l in range(n_lags):
-                if lags[l] > s:
-                    continue  # before the stream's start: a zero row
-                past = &history[(s - lags[l]) % depth, 0]
-                for d in range(n_cls):
-                    if past[d] != 0.0:
-                        weight = &weights[l, d, 0]
-                        for c in range(n_cls):
-                            proba[t, c] += past[d] * weight[c]
-            top = proba[t, 0]
-            for c in range(1, n_cls):
-                if proba[t, c] > top:
-                    top = proba[t, c]
-            total = 0.0
-            for c in range(n_cls):
-                w = exp(proba[t, c] - top)
-                proba[t, c] = w
-                total += w
-            for c in range(n_cls):
-                proba[t, c] /= total
-                if c != none_index and proba[t, c] > score[t]:
-                    score[t] = proba[t, c]
-                    best[t] = c
