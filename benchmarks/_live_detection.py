@@ -35,9 +35,9 @@ REFRACTORY = (8, 15, 23)  # frames: 0.5, 1 and 1.5 s
 DELAYS = (1, 2, 3, 4)  # frames of look-ahead of trigger="maximum" (0.07 to 0.27 s)
 # LinearGestureDetector's settings, chosen with the event rule by the same GroupKFold: its
 # defaults (segments of 4 frames, 64 reference poses, C=0.01, positives at the action point and
-# the 4 frames after it, negatives more than 4 frames away) and the previous positive band (the
+# the 4 frames after it, negatives more than 3 frames away) and the previous positive band (the
 # action point +- 1, negatives more than 1 frame away). In benchmarks/study_live_linear_settings.py
-# (out-of-fold F1 at 0.5 s on half the training takes) the band (0, 4) gave 0.762 against 0.733
+# (out-of-fold F1 at 0.5 s on half the training takes) the band (0, 4) gave 0.761 against 0.733
 # for +- 1; 0 / 64 / 128 poses 0.645 / 0.729 / 0.715; C 0.03 lost to 0.01 in the last two runs
 LINEAR_GRID = ({}, {"jitter": 1, "negative_gap": 1})
 GESTURES = (
@@ -208,7 +208,7 @@ def detectors(step, window, chosen=None):
     }
     # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the size); the rest
     # are the detector's defaults (positive windows end at the action point and the 4 frames
-    # after it, 80 negatives per take end anywhere more than 4 frames from them)
+    # after it, 80 negatives per take end anywhere more than 3 frames from them)
     found[LINEAR] = LinearGestureDetector(root=0, size_joints=(0, 2), random_state=0)
     if chosen:
         found = {k: v for k, v in found.items() if any(c.lower() in k.lower() for c in chosen)}
