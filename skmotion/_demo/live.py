@@ -170,7 +170,7 @@ def _msrc12_detection(context, lines):
 
     # Kinect v1: joint 0 is the hip centre, joint 2 the shoulder centre (the body's size);
     # the event rule is the detector's default, the one benchmarks/bench_live.py chose by
-    # CV over training people (trigger "maximum", look-ahead 3 frames, threshold 0.45)
+    # CV over training people (trigger "maximum", look-ahead 1 frame, threshold 0.65)
     detector = LinearGestureDetector(root=0, size_joints=(0, 2), random_state=context.random_state)
     detector.fit(pick(takes, train), names[train], action_points=pick(points, train))
     held, held_points = pick(takes, ~train), pick(points, ~train)

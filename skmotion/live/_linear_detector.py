@@ -87,17 +87,17 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         Two joints whose distance divides the positions; None: no division.
     C : float, default=0.01
         Inverse regularisation of the logistic regression (on standardised segment means).
-    threshold : float, default=0.45
+    threshold : float, default=0.65
         The probability of the best motion that starts (``"rise"``) or whose
         loss ends (``"fall"``) an event.
     refractory : int, default=15
         The fewest frames between two events.
     trigger : {"fall", "maximum", "peak", "rise"}, default="maximum"
         As for :class:`GestureDetector`. The defaults of the rule (``"maximum"``,
-        look-ahead 3 frames, threshold 0.45, refractory period 15 frames) are
+        look-ahead 1 frame, threshold 0.65, refractory period 15 frames) are
         the choice of ``GroupKFold(3)`` over the MSRC-12 training people
         (``benchmarks/bench_live.py --only detection``).
-    delay : int, default=3
+    delay : int, default=1
         With ``trigger="maximum"``: the frames of look-ahead that confirm a
         maximum (an event comes ``delay`` frames after the window it names).
     jitter : int or (int, int), default=(0, 4)
@@ -164,16 +164,16 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
     ...     take[end - 19 : end + 1] += np.linspace(0, 1, 20)[:, None]
     >>> detector = LinearGestureDetector(random_state=0)
     >>> detector = detector.fit([take], ["rise"], action_points=[points])
-    >>> # trigger="maximum": ``delay`` (3) frames after the window of the highest score
+    >>> # trigger="maximum": ``delay`` (1) frame after the window of the highest score
     >>> [event.frame for event in detector.detect([take])[0]]
-    [53, 123, 193, 265, 333]
+    [51, 121, 191, 261, 331]
     >>> stream = detector.stream()                       # the same, one frame at a time
     >>> [event.frame for frame in take for event in stream.update(frame)]
-    [53, 123, 193, 265, 333]
+    [51, 121, 191, 261, 331]
     >>> # trigger="fall": when the score drops below the threshold after its run above it
     >>> detector = detector.set_params(trigger="fall")
     >>> [event.frame for event in detector.detect([take])[0]]
-    [55, 125, 195, 264, 334]
+    [54, 124, 195, 264, 334]
     """
 
     _parameter_constraints = {
@@ -205,10 +205,10 @@ class LinearGestureDetector(ClipEstimatorMixin, BaseEstimator):
         root=None,
         size_joints=None,
         C=0.01,
-        threshold=0.45,
+        threshold=0.65,
         refractory=15,
         trigger="maximum",
-        delay=3,
+        delay=1,
         jitter=(0, 4),
         n_negatives=80,
         hard_negatives=0,
