@@ -13,7 +13,7 @@ from sklearn.utils.validation import check_is_fitted
 from skmotion.base import ClipEstimatorMixin, MotionTags
 from skmotion.live._detector import training_takes
 from skmotion.live._events import TRIGGERS, TriggerState, maximum_step, next_events
-from skmotion.live._window_kernel import frame_features, window_scores
+from skmotion.live._window_kernel import FrameStep, frame_features, window_scores
 from skmotion.live._windows import training_ends
 from skmotion.utils._clips import check_clips
 from skmotion.utils._sklearn_compat import Interval, StrOptions, _fit_context
@@ -475,13 +475,15 @@ class LinearDetectorStream:
         self._threshold, self._fall = d.threshold, d.trigger == "fall"
         self._runs = d.trigger in ("fall", "peak")  # the triggers that follow runs of windows
         self._maximum = d.trigger == "maximum"
-        self._step = dict(threshold=d.threshold, refractory=d.refractory, delay=d.delay)
+        self._rule_step = dict(threshold=d.threshold, refractory=d.refractory, delay=d.delay)
         n_classes = len(d.classes_)
         self._ring = np.zeros((d.window, d.n_segments, n_classes))
         self._previous = np.zeros(d.n_features_in_)
         self._feature = np.zeros(d.weights_.shape[1])
-        self._one = (np.zeros((1, n_classes)), np.zeros(1), np.zeros(1, dtype=np.intp))
-        self.last_proba = self._one[0][0]
+        one = (np.zeros((1, n_classes)), np.zeros(1), np.zeros(1, dtype=np.intp))
+        self._one, self.last_proba = one, one[0][0]
+        # the one-frame call: the same arrays bound once (the ring, the last pose, last_proba)
+        self._step = FrameStep(self._previous, self._feature, self._ring, *self._args, *one)
         self.reset()
 
     def reset(self):
@@ -524,8 +526,11 @@ class LinearDetectorStream:
         frames = np.ascontiguousarray(frames, dtype=float)
         width = len(self._previous)
         if frames.shape == (width,):  # the one-frame path: no copies, one compiled call
-            proba, score, best = self._score(frames.reshape(1, width), self._one)
-            state, top = self._state, float(score[0])
+            top, best = self._step(frames, self.n_frames)
+            if top != top:  # NaN: the frame held NaN or infinity and was not taken
+                raise ValueError(f"update: frame {self.n_frames} holds NaN or infinity.")
+            self.n_frames += 1
+            state = self._state
             # the two cases in which next_events would emit nothing, said in scalars
             if state.run_best is None and top < self._threshold:
                 # below the threshold, no run open and no maximum waiting for its look-ahead
@@ -537,16 +542,16 @@ class LinearDetectorStream:
                 if state.run_score == np.inf:  # "peak" has fired in this run: nothing until it ends
                     return []
                 if top > state.run_score:  # a run goes on: it keeps its best motion
-                    self._state = state._replace(run_best=best[0], run_score=top)
+                    self._state = state._replace(run_best=best, run_score=top)
                     return []
                 if self._fall or top == state.run_score:
                     return []
             if self._maximum:  # the same rule in scalars: a few rows, no array operations
                 events, self._state = maximum_step(
-                    state, self.n_frames - 1, top, int(best[0]), self._classes, **self._step
+                    state, self.n_frames - 1, top, best, self._classes, **self._rule_step
                 )
                 return events
-            start = self.n_frames - 1
+            start, (proba, score, _) = self.n_frames - 1, self._one
         else:
             if frames.ndim != 2 or frames.shape[1] != width:
                 raise ValueError(

@@ -28,16 +28,35 @@ cdef inline void _soft_poses(const double *pose, Py_ssize_t n_channels, const do
                              Py_ssize_t n_poses, double width, double *out) noexcept nogil:
     """``out[j]``: the soft assignment of ``pose`` to reference pose ``j`` (they sum to 1);
     ``poses`` holds ``n_poses`` rows of ``n_channels``."""
-    cdef Py_ssize_t j, c
+    cdef Py_ssize_t j, c, last = n_poses - n_poses % 4
     cdef double d, e, nearest = INFINITY, total = 0.0
-    for j in range(n_poses):
+    cdef double d0, d1, d2, d3
+    cdef const double *p
+    # four poses at a time: four independent sums hide the latency of an addition that
+    # one running sum waits for (each pose's sum still runs over the channels in order,
+    # so every distance is the same double as one pose at a time)
+    for j in range(0, last, 4):
+        p = poses + j * n_channels
+        d0 = d1 = d2 = d3 = 0.0
+        for c in range(n_channels):
+            e = pose[c] - p[c]
+            d0 += e * e
+            e = pose[c] - p[n_channels + c]
+            d1 += e * e
+            e = pose[c] - p[2 * n_channels + c]
+            d2 += e * e
+            e = pose[c] - p[3 * n_channels + c]
+            d3 += e * e
+        out[j], out[j + 1], out[j + 2], out[j + 3] = d0, d1, d2, d3
+    for j in range(last, n_poses):
         d = 0.0
         for c in range(n_channels):
             e = pose[c] - poses[j * n_channels + c]
             d += e * e
         out[j] = d
-        if d < nearest:
-            nearest = d
+    for j in range(n_poses):
+        if out[j] < nearest:
+            nearest = out[j]
     for j in range(n_poses):
         # a term below exp(-36) (2e-16) of the nearest pose's is under the rounding of the
         # sum: zero, rather than a subnormal number that slows every product it enters
@@ -109,14 +128,16 @@ def frame_features(const double[:, ::1] frames, Py_ssize_t root, Py_ssize_t size
     return out
 
 
-cdef Py_ssize_t _window_scores(const double[:, ::1] frames, double[::1] previous,
-                               double[::1] feature, double[:, :, ::1] ring, Py_ssize_t seen,
+cdef Py_ssize_t _window_scores(const double *frames, Py_ssize_t n, Py_ssize_t m,
+                               double[::1] previous, double[::1] feature,
+                               double[:, :, ::1] ring, Py_ssize_t seen,
                                const double[:, ::1] weights, const double[::1] bias,
                                Py_ssize_t root, Py_ssize_t size_a, Py_ssize_t size_b,
                                const double[:, ::1] poses, double width,
                                Py_ssize_t segment, Py_ssize_t none_index, double[:, ::1] proba,
                                double[::1] score, Py_ssize_t[::1] best) noexcept nogil:
-    cdef Py_ssize_t n = frames.shape[0], m = frames.shape[1], n_seg = ring.shape[1]
+    """The loop of :func:`window_scores` over ``n`` frames of ``m`` channels, row after row."""
+    cdef Py_ssize_t n_seg = ring.shape[1]
     cdef Py_ssize_t n_feat = weights.shape[0], n_cls = ring.shape[2], n_rows = n_seg * n_cls
     cdef Py_ssize_t window = ring.shape[0], t, i, k, j, f, c, slot, s
     cdef double v, top, total, w
@@ -125,10 +146,10 @@ cdef Py_ssize_t _window_scores(const double[:, ::1] frames, double[::1] previous
     cdef const double *reference = _rows(poses)
     for t in range(n):
         for c in range(m):
-            if not isfinite(frames[t, c]):
+            if not isfinite(frames[t * m + c]):
                 return t
         s = seen + t
-        _features(&frames[t, 0], m, root, size_a, size_b, &previous[0], s == 0, reference,
+        _features(frames + t * m, m, root, size_a, size_b, &previous[0], s == 0, reference,
                   poses.shape[0], width, &feature[0])
         slot = s % window
         # the frame's rows for every segment, side by side: one contiguous loop per feature
@@ -191,5 +212,54 @@ def window_scores(const double[:, ::1] frames, double[::1] previous, double[::1]
     infinity (the frames before it are taken), or -1.
     """
     # the GIL is kept: a call is a frame or a take of a few microseconds of work per frame
-    return _window_scores(frames, previous, feature, ring, seen, weights, bias, root, size_a,
-                          size_b, poses, width, segment, none_index, proba, score, best)
+    if frames.shape[0] == 0:
+        return -1
+    return _window_scores(&frames[0, 0], frames.shape[0], frames.shape[1], previous, feature,
+                          ring, seen, weights, bias, root, size_a, size_b, poses, width, segment,
+                          none_index, proba, score, best)
+
+
+cdef class FrameStep:
+    """The one-frame call of a stream: the kernel's arrays bound once, one frame per call.
+
+    A Python call that passes the seventeen arrays and numbers of
+    :func:`window_scores` spends about as long unpacking them as the kernel
+    spends on a frame; this holds them (the same arrays as the stream's, so
+    the two calls share one state) and takes the frame alone.
+    """
+
+    cdef double[::1] previous, feature, score
+    cdef double[:, :, ::1] ring
+    cdef const double[:, ::1] weights, poses
+    cdef const double[::1] bias
+    cdef double[:, ::1] proba
+    cdef Py_ssize_t[::1] best
+    cdef Py_ssize_t root, size_a, size_b, segment, none_index
+    cdef double width
+
+    def __init__(self, double[::1] previous, double[::1] feature, double[:, :, ::1] ring,
+                 const double[:, ::1] weights, const double[::1] bias, Py_ssize_t root,
+                 Py_ssize_t size_a, Py_ssize_t size_b, const double[:, ::1] poses, double width,
+                 Py_ssize_t segment, Py_ssize_t none_index, double[:, ::1] proba,
+                 double[::1] score, Py_ssize_t[::1] best):
+        if proba.shape[0] != 1 or score.shape[0] != 1 or best.shape[0] != 1:
+            raise ValueError("FrameStep writes one row: proba, score and best hold one.")
+        self.previous, self.feature, self.ring = previous, feature, ring
+        self.weights, self.bias, self.poses, self.width = weights, bias, poses, width
+        self.root, self.size_a, self.size_b = root, size_a, size_b
+        self.segment, self.none_index = segment, none_index
+        self.proba, self.score, self.best = proba, score, best
+
+    def __call__(self, const double[::1] frame, Py_ssize_t seen):
+        """Feed one frame to a stream that has seen ``seen``; ``(score, best)`` of its window
+        (``(-1.0, -1)`` before the first full window), the probabilities in ``proba``.
+        ``score`` is NaN when the frame holds NaN or infinity (nothing is taken then)."""
+        if frame.shape[0] != self.previous.shape[0]:
+            raise ValueError(f"a frame of {self.previous.shape[0]} channels is needed, "
+                             f"got {frame.shape[0]}.")
+        if _window_scores(&frame[0], 1, frame.shape[0], self.previous, self.feature, self.ring,
+                          seen, self.weights, self.bias, self.root, self.size_a, self.size_b,
+                          self.poses, self.width, self.segment, self.none_index, self.proba,
+                          self.score, self.best) == 0:
+            return float("nan"), -1
+        return self.score[0], self.best[0]

@@ -152,6 +152,20 @@ def test_the_stream_memory_does_not_grow(fitted, skeleton_takes):
     assert stream._ring.shape == (fitted.window, fitted.n_segments, len(fitted.classes_))
 
 
+def test_a_bad_frame_one_per_call_is_refused_and_not_taken(fitted, skeleton_takes):
+    take = skeleton_takes[0][5]
+    (batch,) = fitted.detect([take])
+    stream, streamed = fitted.stream(), []
+    for t, frame in enumerate(take):
+        if t in (3, 40):  # a NaN and an infinity, each refused before the good frame
+            bad = frame.copy()
+            bad[7] = np.nan if t == 3 else np.inf
+            with pytest.raises(ValueError, match=f"update: frame {t} holds NaN or infinity"):
+                stream.update(bad)
+        streamed += stream.update(frame)
+    assert streamed == batch and stream.n_frames == len(take)  # the stream went on untouched
+
+
 def test_bad_input_is_named(fitted, skeleton_takes):
     takes, points, labels = skeleton_takes
     stream = fitted.stream()
