@@ -213,7 +213,7 @@ def _draw_detection(detector, ends, proba, points, events, gesture, rate=15.0):
         ax.set_ylabel("probability")
         ax.set_ylim(0, 1.1)
         ax.set_title(f"A held-out MSRC-12 take ('{gesture}'), streamed frame by frame", fontsize=10)
-        ax.legend(loc="lower right", fontsize=7, ncol=4)
+        ax.legend(loc="center left", fontsize=7)  # MSRC-12 takes start at rest: room there
         fig.tight_layout()
         return fig
 
