@@ -1,6 +1,6 @@
 """LinearGestureDetector's settings on MSRC-12: out-of-fold F1 over the training people only.
 
-Issue 27 asks for better detection timing. Each candidate is the benchmark's
+Issue 27 asks for better detection. Each candidate is the benchmark's
 ``LinearGestureDetector`` (``_live_detection.detectors``: root-centred, size-normalised
 frames, 80 negatives per take) with a few parameters changed; its windows are scored
 out of fold by ``GroupKFold(3)`` over the training people (odd ids; every ``--subsample``-th
@@ -14,8 +14,8 @@ Usage::
     python benchmarks/study_live_linear_settings.py --subsample 2 \\
         --candidates '{"negative_gap": 1}' '{"segment": 4, "negative_gap": 1}'
 
-Writes ``results/live_linear_settings.{csv,md}``; needs ``../shared/data/msrc12``
-(or ``SKMOTION_SHARED_DATA``).
+Writes ``results/live_linear_settings.{csv,md}`` (``--output NAME``: ``results/NAME.*``, so
+that two studies can run at once); needs ``../shared/data/msrc12`` (or ``SKMOTION_SHARED_DATA``).
 """
 
 import argparse
