@@ -79,8 +79,8 @@ permute = module("skmotion.tree._build._permute")
 # A tree node's moments (centred in cached chunks, one dsyrk each) and the partition of its
 # rows at a cut, in place and without the GIL (tree/_build/_node_passes, the build's passes).
 node_passes = module("skmotion.tree._build._node_passes")
-# Frames walked down the upper layers of a motion tree from their projections, one compiled
-# loop instead of array operations per layer (tree/_encoding/_routing, the encoder's router).
+# Frames walked down a motion tree, each on its own path (one dot product per layer), one
+# compiled loop instead of array operations per layer (tree/_encoding/_routing, the router).
 walk = module("skmotion.tree._encoding._walk")
 # The encoder's residuals, moments and magnitude check, one pass over each clip's frames
 # (tree/_encoding/_histograms); no contraction: the doubles of the NumPy expressions.
