@@ -92,6 +92,9 @@ live_window = module("skmotion.live._window_kernel")
 live_path = module("skmotion.live._switch_path")
 # Forward kinematics, one pass over frames and joints (kinematics/_forward.py).
 forward_loops = module("skmotion.kinematics._forward_loops")
+# Each clip's channel covariance, its triangle row by row, one dsyrk per clip
+# (recognition/_motion_classifier.clip_covariances).
+covariance_rows = module("skmotion.recognition._covariance_rows")
 setup(
     ext_modules=cythonize(
         [
@@ -110,6 +113,7 @@ setup(
             live_window,
             live_path,
             forward_loops,
+            covariance_rows,
         ]
     )
 )

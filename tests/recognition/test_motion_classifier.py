@@ -12,6 +12,7 @@ from sklearn.model_selection import GridSearchCV, GroupKFold
 from sklearn.neighbors import KNeighborsClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
+from skmotion.recognition._covariance_rows import covariance_rows
 
 from skmotion.datasets import make_motions, make_position_motions
 from skmotion.preprocessing import FlattenClips, ResampleClips, VirtualMarkerTransform
@@ -295,10 +296,11 @@ def test_msrc12_cross_subject(shared_data):
     assert model.score(pick(~train), data.gesture[~train]) >= 0.9
 
 
-@settings(max_examples=30, deadline=None)
-@given(st.lists(st.integers(1, 30), min_size=1, max_size=5), st.integers(1, 6))
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.integers(1, 60), min_size=1, max_size=5), st.integers(1, 40))
 def test_clip_covariances_are_numpys_covariance(lengths, n_channels):
-    """Each row is the upper triangle of ``np.cov(bias=True)`` of its clip (0 for one frame)."""
+    """Each row is the upper triangle of ``np.cov(bias=True)`` of its clip (0 for one frame):
+    the compiled pass (one dsyrk per clip, the triangle copied row by row) against NumPy."""
     rng = np.random.default_rng(len(lengths) * 7 + n_channels)
     clips = [rng.normal(size=(n, n_channels)) * rng.uniform(0.1, 5, n_channels) for n in lengths]
     rows, cols = np.triu_indices(n_channels)
@@ -306,7 +308,15 @@ def test_clip_covariances_are_numpys_covariance(lengths, n_channels):
     for i, clip in enumerate(clips):
         if len(clip) > 1:
             expected[i] = np.atleast_2d(np.cov(clip, rowvar=False, bias=True))[rows, cols]
-    np.testing.assert_allclose(clip_covariances(clips), expected, atol=1e-12)
+    np.testing.assert_allclose(clip_covariances(clips), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_covariance_rows_name_bad_offsets():
+    frames = np.zeros((5, 2))
+    with pytest.raises(ValueError, match="clip 1 has no frames"):
+        covariance_rows(frames, np.array([0, 2, 2, 5]))
+    with pytest.raises(ValueError, match="from 0 to the 5 frames"):
+        covariance_rows(frames, np.array([0, 4]))
 
 
 def test_covariance_weight_appends_the_weighted_covariances():
