@@ -34,7 +34,7 @@ def _load():
 _load()
 
 
-def covariance_rows(const double[:, ::1] frames, const intp[::1] offsets):
+def covariance_rows(const double[:, ::1] frames, const intp[::1] offsets, out=None):
     """Per clip, entries ``(j, k)``, ``j <= k``, of its channels' covariance, row by row.
 
     Parameters
@@ -43,6 +43,9 @@ def covariance_rows(const double[:, ::1] frames, const intp[::1] offsets):
         The clips' frames, clip after clip.
     offsets : ndarray of shape (n_clips + 1,) of intp
         Clip ``i`` is frames ``offsets[i]:offsets[i + 1]``, none empty (checked).
+    out : ndarray of shape (n_clips, d * (d + 1) // 2), default=None
+        Written in place and returned (e.g. the columns of a larger table whose rows are
+        strided): no copy of the rows into it afterwards.
 
     Returns
     -------
@@ -67,11 +70,14 @@ def covariance_rows(const double[:, ::1] frames, const intp[::1] offsets):
         longest = max(longest, offsets[i + 1] - offsets[i])
     if longest * d >= 2**31 or d >= 2**31:
         raise ValueError(f"a clip of {longest} frames x {d} channels is too large for BLAS.")
-    rows_array = np.empty((n_clips, d * (d + 1) // 2))
+    rows_array = np.empty((n_clips, d * (d + 1) // 2)) if out is None else out
+    if rows_array.shape != (n_clips, d * (d + 1) // 2):
+        raise ValueError(f"out must have shape {(n_clips, d * (d + 1) // 2)}.")
     buffer_array = np.empty((max(longest, 1), max(d, 1)))
     product_array = np.empty((max(d, 1), max(d, 1)))
     mean_array = np.empty(max(d, 1))
-    cdef double[:, ::1] rows = rows_array, buffer = buffer_array, product = product_array
+    cdef double[:, :] rows = rows_array
+    cdef double[:, ::1] buffer = buffer_array, product = product_array
     cdef double[::1] mean = mean_array
     cdef int d_int = <int>d, k_int
     cdef double one = 1.0, zero = 0.0

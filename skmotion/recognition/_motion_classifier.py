@@ -463,10 +463,16 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         return self._vocabulary(self._clips(X))  # _clips checks that the model is fitted
 
     def _vocabulary(self, clips):
-        features = self.encoder_.transform(clips)
-        if self._with_covariances:
-            features = np.hstack([features, clip_covariances(clips)])
-        return features
+        encoded = self.encoder_.transform(clips)
+        if not self._with_covariances:
+            return encoded
+        # the covariances written into their columns of the table (no copy of them after)
+        n_channels, width = clips[0].shape[1], encoded.shape[1]
+        table = np.empty((len(clips), width + n_channels * (n_channels + 1) // 2))
+        table[:, :width] = encoded
+        frames, offsets = stack_clips(clips)
+        covariance_rows(frames, offsets, table[:, width:])
+        return table
 
     def _columns(self, features):
         return (features - self.column_center_) / self.column_scale_

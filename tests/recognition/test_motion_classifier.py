@@ -311,6 +311,19 @@ def test_clip_covariances_are_numpys_covariance(lengths, n_channels):
     np.testing.assert_allclose(clip_covariances(clips), expected, rtol=1e-12, atol=1e-12)
 
 
+def test_covariance_rows_write_into_a_tables_columns():
+    # MotionClassifier's vocabulary: the covariances written into the last columns of a
+    # wider table (strided rows), the same values as a fresh array, the other columns kept
+    rng = np.random.default_rng(0)
+    frames, offsets = rng.normal(size=(9, 3)), np.array([0, 4, 9])
+    table = np.full((2, 8), 7.0)
+    covariance_rows(frames, offsets, table[:, 2:])
+    assert np.array_equal(table[:, 2:], covariance_rows(frames, offsets))
+    assert (table[:, :2] == 7.0).all()
+    with pytest.raises(ValueError, match=r"out must have shape \(2, 6\)"):
+        covariance_rows(frames, offsets, table)
+
+
 def test_covariance_rows_name_bad_offsets():
     frames = np.zeros((5, 2))
     with pytest.raises(ValueError, match="clip 1 has no frames"):
