@@ -201,6 +201,21 @@ def test_probabilities_and_decisions_agree(positions):
     np.testing.assert_allclose(model.decision_function(Xte), direct, rtol=1e-9, atol=1e-9)
 
 
+@pytest.mark.parametrize("n_classes", [2, 3])
+def test_predict_and_decisions_are_the_readouts_own(positions, n_classes):
+    # predict and decision_function take the readout's product without sklearn's input
+    # checks: the same doubles and labels as its decision_function and predict, also for
+    # two classes (one column of logits, its sign)
+    Xtr, ytr, Xte, _ = _split(positions)
+    keep = np.isin(ytr, np.unique(ytr)[:n_classes])
+    model = MotionClassifier(layout="kinect_v2", frame_rate=positions.frame_rate, max_depth=3)
+    model.fit([x for x, k in zip(Xtr, keep) if k], ytr[keep])
+    features = model._raw(Xte)
+    assert np.array_equal(model.decision_function(Xte), model._readout.decision_function(features))
+    assert np.array_equal(model.predict(Xte), model._readout.predict(features))
+    assert len(set(model.predict(Xte))) == n_classes  # both signs / several classes seen
+
+
 def test_novelty_ranks_foreign_clips_lower(positions):
     Xtr, ytr, Xte, _ = _split(positions)
     model = MotionClassifier(layout="kinect_v2", frame_rate=positions.frame_rate, max_depth=4)
