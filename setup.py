@@ -79,8 +79,8 @@ permute = module("skmotion.tree._build._permute")
 # A tree node's moments (centred in cached chunks, one dsyrk each) and the partition of its
 # rows at a cut, in place and without the GIL (tree/_build/_node_passes, the build's passes).
 node_passes = module("skmotion.tree._build._node_passes")
-# Frames walked down the upper layers of a motion tree from their projections, one compiled
-# loop instead of array operations per layer (tree/_encoding/_routing, the encoder's router).
+# Frames walked down a motion tree, each on its own path (one dot product per layer), one
+# compiled loop instead of array operations per layer (tree/_encoding/_routing, the router).
 walk = module("skmotion.tree._encoding._walk")
 # The encoder's residuals, moments and magnitude check, one pass over each clip's frames
 # (tree/_encoding/_histograms); no contraction: the doubles of the NumPy expressions.
@@ -92,6 +92,9 @@ live_window = module("skmotion.live._window_kernel")
 live_path = module("skmotion.live._switch_path")
 # Forward kinematics, one pass over frames and joints (kinematics/_forward.py).
 forward_loops = module("skmotion.kinematics._forward_loops")
+# Each clip's channel covariance, its triangle row by row, one dsyrk per clip
+# (recognition/_motion_classifier.clip_covariances).
+covariance_rows = module("skmotion.recognition._covariance_rows")
 setup(
     ext_modules=cythonize(
         [
@@ -110,6 +113,7 @@ setup(
             live_window,
             live_path,
             forward_loops,
+            covariance_rows,
         ]
     )
 )

@@ -5,6 +5,7 @@ from collections import namedtuple
 import numpy as np
 
 from skmotion.kinematics import forward_kinematics
+from skmotion.kinematics._forward_loops import marker_pass
 
 __all__ = ["Marker", "MarkerSet"]
 
@@ -151,6 +152,7 @@ class MarkerSet:
         """
         joints = self.joint_indices(skeleton)
         fk = forward_kinematics(skeleton, channels)
-        return fk.positions[:, joints] + np.einsum(
-            "fmij,mj->fmi", fk.rotations[:, joints], self.offsets
-        )
+        # p + R @ offset in one compiled pass (no gathered copies of the joints' poses)
+        out = np.empty((len(fk.positions), len(joints), 3))
+        marker_pass(fk.positions, fk.rotations, joints, self.offsets, out)
+        return out

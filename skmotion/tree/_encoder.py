@@ -162,10 +162,11 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
 
     Notes
     -----
-    Routing is one pass over the layers for all frames of all clips together
-    (:class:`~skmotion.tree._encoding.TreeRouter`, the standardisation folded
-    into the splits), and the histograms are one sparse matrix whose duplicate
-    entries sum: no Python step per clip or frame. The defaults come from a
+    Routing is one compiled walk of all frames of all clips together, each
+    frame down its own path (:class:`~skmotion.tree._encoding.TreeRouter`, the
+    standardisation folded into the splits), and the histograms are one sparse
+    matrix whose duplicate entries sum (one compiled pass into a dense array with
+    ``sparse_output=False``): no Python step per clip or frame. The defaults come from a
     study over several data sets (user guide, ``docs/motion-database.md``).
 
     Memory: from 2**18 frames on (float64 clips of two channels or more),
@@ -374,7 +375,11 @@ class MotionTreeEncoder(ClipFeatureMixin, BaseEstimator):
             residual_nodes = nodes[:, residual_columns]
         parts = []
         if self._blocks:
-            parts.append(histogram_features(nodes, offsets, routed, self._blocks, self.power))
+            parts.append(
+                histogram_features(
+                    nodes, offsets, routed, self._blocks, self.power, dense=not sparse
+                )
+            )
         if len(self.residual_layers_):
             parts.append(
                 residual_features(

@@ -2,6 +2,7 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from skmotion.kinematics._forward_loops import marker_pass
 
 from skmotion.kinematics import Skeleton, euler_to_matrix, forward_kinematics, matrix_to_euler
 
@@ -251,3 +252,38 @@ def test_euler_to_matrix_matches_scipy_intrinsic(order, rng):
     np.testing.assert_allclose(
         euler_to_matrix(angles, order), Rotation.from_euler(order, angles).as_matrix(), atol=1e-14
     )
+
+
+@given(
+    n_frames=st.integers(0, 5),
+    n_joints=st.integers(1, 4),
+    joints=st.lists(st.integers(0, 3), max_size=6),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_marker_pass_is_the_joint_pose_applied_to_each_offset(n_frames, n_joints, joints, seed):
+    """``p_joint + R_joint @ offset`` per frame and point, against a loop of matrix products
+    (NumPy's einsum, which it replaced in ``MarkerSet.positions``, may fuse its products
+    into FMAs: the same to rounding, not always to the bit)."""
+    rng = np.random.default_rng(seed)
+    joints = np.array([j % n_joints for j in joints], dtype=np.intp)
+    positions = rng.normal(size=(n_frames, n_joints, 3))
+    rotations = rng.normal(size=(n_frames, n_joints, 3, 3))
+    offsets = rng.normal(size=(len(joints), 3))
+    out = np.empty((n_frames, len(joints), 3))
+    marker_pass(positions, rotations, joints, offsets, out)
+    for f in range(n_frames):
+        for m, j in enumerate(joints):
+            np.testing.assert_allclose(
+                out[f, m], positions[f, j] + rotations[f, j] @ offsets[m], rtol=1e-13, atol=1e-13
+            )
+
+
+def test_marker_pass_names_a_joint_out_of_range():
+    with pytest.raises(ValueError, match="point 1's joint 2 is not among the 2"):
+        marker_pass(
+            np.zeros((1, 2, 3)),
+            np.zeros((1, 2, 3, 3)),
+            np.array([0, 2]),
+            np.zeros((2, 3)),
+            np.empty((1, 2, 3)),
+        )

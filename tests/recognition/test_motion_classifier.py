@@ -12,6 +12,7 @@ from sklearn.model_selection import GridSearchCV, GroupKFold
 from sklearn.neighbors import KNeighborsClassifier
 from sklearn.pipeline import make_pipeline
 from sklearn.preprocessing import StandardScaler
+from skmotion.recognition._covariance_rows import covariance_rows
 
 from skmotion.datasets import make_motions, make_position_motions
 from skmotion.preprocessing import FlattenClips, ResampleClips, VirtualMarkerTransform
@@ -200,6 +201,21 @@ def test_probabilities_and_decisions_agree(positions):
     np.testing.assert_allclose(model.decision_function(Xte), direct, rtol=1e-9, atol=1e-9)
 
 
+@pytest.mark.parametrize("n_classes", [2, 3])
+def test_predict_and_decisions_are_the_readouts_own(positions, n_classes):
+    # predict and decision_function take the readout's product without sklearn's input
+    # checks: the same doubles and labels as its decision_function and predict, also for
+    # two classes (one column of logits, its sign)
+    Xtr, ytr, Xte, _ = _split(positions)
+    keep = np.isin(ytr, np.unique(ytr)[:n_classes])
+    model = MotionClassifier(layout="kinect_v2", frame_rate=positions.frame_rate, max_depth=3)
+    model.fit([x for x, k in zip(Xtr, keep) if k], ytr[keep])
+    features = model._raw(Xte)
+    assert np.array_equal(model.decision_function(Xte), model._readout.decision_function(features))
+    assert np.array_equal(model.predict(Xte), model._readout.predict(features))
+    assert len(set(model.predict(Xte))) == n_classes  # both signs / several classes seen
+
+
 def test_novelty_ranks_foreign_clips_lower(positions):
     Xtr, ytr, Xte, _ = _split(positions)
     model = MotionClassifier(layout="kinect_v2", frame_rate=positions.frame_rate, max_depth=4)
@@ -295,10 +311,11 @@ def test_msrc12_cross_subject(shared_data):
     assert model.score(pick(~train), data.gesture[~train]) >= 0.9
 
 
-@settings(max_examples=30, deadline=None)
-@given(st.lists(st.integers(1, 30), min_size=1, max_size=5), st.integers(1, 6))
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.integers(1, 60), min_size=1, max_size=5), st.integers(1, 40))
 def test_clip_covariances_are_numpys_covariance(lengths, n_channels):
-    """Each row is the upper triangle of ``np.cov(bias=True)`` of its clip (0 for one frame)."""
+    """Each row is the upper triangle of ``np.cov(bias=True)`` of its clip (0 for one frame):
+    the compiled pass (one dsyrk per clip, the triangle copied row by row) against NumPy."""
     rng = np.random.default_rng(len(lengths) * 7 + n_channels)
     clips = [rng.normal(size=(n, n_channels)) * rng.uniform(0.1, 5, n_channels) for n in lengths]
     rows, cols = np.triu_indices(n_channels)
@@ -306,7 +323,28 @@ def test_clip_covariances_are_numpys_covariance(lengths, n_channels):
     for i, clip in enumerate(clips):
         if len(clip) > 1:
             expected[i] = np.atleast_2d(np.cov(clip, rowvar=False, bias=True))[rows, cols]
-    np.testing.assert_allclose(clip_covariances(clips), expected, atol=1e-12)
+    np.testing.assert_allclose(clip_covariances(clips), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_covariance_rows_write_into_a_tables_columns():
+    # MotionClassifier's vocabulary: the covariances written into the last columns of a
+    # wider table (strided rows), the same values as a fresh array, the other columns kept
+    rng = np.random.default_rng(0)
+    frames, offsets = rng.normal(size=(9, 3)), np.array([0, 4, 9])
+    table = np.full((2, 8), 7.0)
+    covariance_rows(frames, offsets, table[:, 2:])
+    assert np.array_equal(table[:, 2:], covariance_rows(frames, offsets))
+    assert (table[:, :2] == 7.0).all()
+    with pytest.raises(ValueError, match=r"out must have shape \(2, 6\)"):
+        covariance_rows(frames, offsets, table)
+
+
+def test_covariance_rows_name_bad_offsets():
+    frames = np.zeros((5, 2))
+    with pytest.raises(ValueError, match="clip 1 has no frames"):
+        covariance_rows(frames, np.array([0, 2, 2, 5]))
+    with pytest.raises(ValueError, match="from 0 to the 5 frames"):
+        covariance_rows(frames, np.array([0, 4]))
 
 
 def test_covariance_weight_appends_the_weighted_covariances():

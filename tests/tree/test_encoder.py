@@ -1,12 +1,13 @@
 """MotionTreeEncoder: routing against the tree's own splits, histograms against a per-clip loop."""
 
+import math
 import pickle
 
 import numpy as np
 import pandas as pd
 import pytest
 import scipy.sparse as sp
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from sklearn.linear_model import LogisticRegression
 from sklearn.model_selection import GroupKFold, cross_val_score
@@ -46,8 +47,7 @@ def test_conformance(check):
 
 @pytest.mark.parametrize("split", ["median", "min_error"])
 def test_routing_matches_the_trees_splits_at_every_layer(split, rng):
-    # 7 layers of median splits: layers with few split nodes take the matrix-product path,
-    # deeper ones the per-frame gather, so both are checked against MotionTree.apply.
+    # 7 layers of median splits, the compiled walk against MotionTree.apply at every layer
     frames = rng.normal(size=(3000, 6)) * [1, 2, 3, 4, 5, 6] + 10
     center, scale = frames.mean(0), frames.std(0)
     tree = MotionTree.build((frames - center) / scale, max_depth=7, split=split, min_samples_leaf=4)
@@ -57,6 +57,49 @@ def test_routing_matches_the_trees_splits_at_every_layer(split, rng):
         np.testing.assert_array_equal(routed[:, layer], expected)
     some = TreeRouter(tree, center, scale).route(frames, [2, 5])
     np.testing.assert_array_equal(some, routed[:, [2, 5]])
+
+
+def _walk_reference(tree, z, layers):
+    """Each standardised frame walked down ``tree`` one node at a time, the projection summed
+    exactly (``math.fsum`` of the products); also whether the frame ever came within
+    rounding of a threshold, where any summation order may send it either way."""
+    out = np.empty((len(z), len(layers)), dtype=np.intp)
+    close = np.zeros(len(z), dtype=bool)
+    for i, frame in enumerate(z):
+        node = 0
+        for layer in range(max(layers) + 1):
+            if layer in layers:
+                out[i, layers.index(layer)] = list(tree.layers[layer]).index(node)
+            if tree.left[node] >= 0:
+                products = frame * tree.axis[node]
+                value, threshold = math.fsum(products), tree.threshold[node]
+                close[i] |= abs(value - threshold) <= 1e-9 * (np.abs(products).sum() + 1.0)
+                node = tree.right[node] if value > threshold else tree.left[node]
+    return out, close
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    d=st.integers(1, 9),
+    depth=st.integers(1, 6),
+    split=st.sampled_from(["median", "two_means", "min_error"]),
+    seed=st.integers(0, 2**32 - 1),
+    data=st.data(),
+)
+def test_the_compiled_walk_matches_a_frame_by_frame_walk(d, depth, split, seed, data):
+    # any number of channels (the dot product's four accumulators and its tail), any depth,
+    # leaves above the bottom (copied down); the training frames and new ones
+    rng = np.random.default_rng(seed)
+    train = rng.normal(size=(200, d)) * rng.uniform(0.5, 3.0, d)
+    tree = MotionTree.build(train, max_depth=depth, split=split, min_samples_leaf=4)
+    layers = sorted(data.draw(st.sets(st.integers(0, tree.n_layers - 1), min_size=1)))
+    new = rng.normal(size=(100, d)) * 2.0
+    router = TreeRouter(tree)
+    for frames, may_be_close in ((train, False), (new, True)):
+        expected, close = _walk_reference(tree, frames, layers)
+        routed = router.route(frames, layers)
+        assert may_be_close or not close.any()  # the gap rule: training frames are clear
+        np.testing.assert_array_equal(routed[~close], expected[~close])
 
 
 def reference_variances(encoder, train):

@@ -16,7 +16,12 @@ from skmotion.utils._group_sums import group_sums
 
 from skmotion.datasets import make_motions
 from skmotion.tree import MotionTreeEncoder
-from skmotion.tree._encoding._histograms import moment_features, residual_features
+from skmotion.tree._encoding._histograms import (
+    feature_blocks,
+    histogram_features,
+    moment_features,
+    residual_features,
+)
 
 
 def clips_and_offsets(rng, lengths, d, decades=3):
@@ -81,6 +86,33 @@ def test_residual_rows_are_the_numpy_doubles(lengths, k, d, power, seed):
     rows = residual_rows(frames, node, offsets, mean, center, scale, True, power == 0.5)
     expected = numpy_residuals(frames, node, offsets, mean, center, scale, power)
     assert np.array_equal(rows, expected)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    lengths=st.lists(st.integers(1, 40), min_size=1, max_size=5),
+    n_nodes=st.lists(st.integers(1, 9), min_size=1, max_size=3),
+    pyramid=st.lists(st.integers(1, 7), min_size=1, max_size=3),
+    transitions=st.booleans(),
+    power=st.sampled_from([0.5, 1.0, 0.3]),
+    seed=st.integers(0, 2**16),
+)
+def test_dense_histograms_are_the_sparse_matrixs_doubles(
+    lengths, n_nodes, pyramid, transitions, power, seed
+):
+    # the compiled dense pass against the sparse matrix whose duplicates sum: every layer's
+    # occupancy over any pyramid (cells without a frame in clips shorter than the level),
+    # the transitions, any power
+    rng = np.random.default_rng(seed)
+    offsets = np.concatenate([[0], np.cumsum(lengths)]).astype(np.intp)
+    layers = list(range(1, len(n_nodes) + 1))
+    nodes = np.column_stack([rng.integers(0, k, size=offsets[-1]) for k in n_nodes])
+    counts = np.zeros(len(layers) + 1, dtype=int)
+    counts[layers] = n_nodes
+    blocks = feature_blocks(layers, counts, pyramid, layers[-1:] if transitions else [])
+    sparse = histogram_features(nodes, offsets, layers, blocks, power)
+    dense = histogram_features(nodes, offsets, layers, blocks, power, dense=True)
+    assert np.array_equal(dense, sparse.toarray())
 
 
 @pytest.mark.parametrize("width", [1, 7, 8, 9, 127, 128, 129, 255, 960, 1000, 30720, 40001])

@@ -220,15 +220,18 @@ def test_fits_leave_the_callers_clips_alone_and_the_encoder_one_clip_rows_are_th
     assert np.array_equal(batch, one)
 
 
-def test_a_router_pickled_without_its_tables_routes_the_same():
+def test_a_router_pickled_with_the_former_product_tables_routes_the_same():
     frames = _frames(3_000)
     tree = MotionTree.build(frames, max_depth=7, split="median")
     router = TreeRouter(tree, frames.mean(axis=0), frames.std(axis=0))
-    state = dict(router.__dict__)
-    for name in ("left_or_self", "right_or_self", "in_product", "walkable", "_products"):
-        del state[name]
+    # the state a router kept before the compiled walk: its product path's tables, and
+    # its arrays as the tree gave them (int64 children, a strided axis)
+    state = dict(router.__dict__, axis=np.asfortranarray(router.axis), left=tree.left.astype(int))
+    former = ("split_ids", "left_or_self", "right_or_self", "in_product", "walkable", "_products")
+    state.update(dict.fromkeys(former))
     old = TreeRouter.__new__(TreeRouter)
     old.__setstate__(state)
+    assert not set(former) & set(old.__dict__)
     assert np.array_equal(old.route(frames), router.route(frames))
     assert np.array_equal(pickle.loads(pickle.dumps(router)).route(frames), router.route(frames))
     # the stepwise routing of the tree itself, on the standardised frames

@@ -1,7 +1,7 @@
 """The encoder's routing and readouts: a clip's frames down a motion tree, then summed per clip.
 
 Offers :class:`TreeRouter` (``_routing.py``: every layer's node of all frames in
-one pass over the layers, the standardisation folded into the splits), the
+one compiled walk, ``_walk.pyx``, the standardisation folded into the splits), the
 per-clip blocks over routed node labels (``_histograms.py``: occupancy with its
 temporal pyramid, transitions, first- and second-order residuals, the clip's
 moments; the residuals, the moments and the magnitude check are compiled passes over

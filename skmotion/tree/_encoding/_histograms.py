@@ -9,7 +9,7 @@ the histograms.
 import numpy as np
 import scipy.sparse as sp
 
-from skmotion.tree._encoding._readout_passes import moment_rows, residual_rows
+from skmotion.tree._encoding._readout_passes import histogram_rows, moment_rows, residual_rows
 from skmotion.utils._group_sums import group_sums
 
 # rows per block of node_variances' squared deviations (bounds its temporaries)
@@ -43,8 +43,8 @@ def feature_blocks(layers, n_nodes, pyramid, transition_layers):
     return blocks
 
 
-def histogram_features(nodes, offsets, layers, blocks, power):
-    """Per-clip normalised histograms of routed frames, as a CSR matrix.
+def histogram_features(nodes, offsets, layers, blocks, power, dense=False):
+    """Per-clip normalised histograms of routed frames, as a CSR matrix (or dense).
 
     Parameters
     ----------
@@ -58,16 +58,21 @@ def histogram_features(nodes, offsets, layers, blocks, power):
         From :func:`feature_blocks`.
     power : float
         Every entry is raised to this power (0.5: Hellinger's square root).
+    dense : bool, default=False
+        Return the same entries as a dense array, summed by one compiled pass over
+        the frames (``_readout_passes.histogram_rows``) with no sparse matrix made.
 
     Returns
     -------
-    features : scipy.sparse.csr_matrix of shape (n_clips, n_features)
+    features : scipy.sparse.csr_matrix or ndarray of shape (n_clips, n_features)
         Occupancy cell ``c`` of ``parts`` holds the share of the clip's frames
         ``[c n / parts, (c + 1) n / parts)`` in each node (each cell sums to 1
         before ``power``); a transition entry is the share of the clip's
         ``n - 1`` steps that go from one node to another (staying is not
         counted: occupancy says it).
     """
+    if dense:
+        return _dense_histograms(nodes, offsets, layers, blocks, power)
     n_clips = len(offsets) - 1
     lengths = np.diff(offsets)
     clip = np.repeat(np.arange(n_clips), lengths)
@@ -103,6 +108,27 @@ def histogram_features(nodes, offsets, layers, blocks, power):
     if power != 1:
         np.power(matrix.data, power, out=matrix.data)
     return matrix
+
+
+def _dense_histograms(nodes, offsets, layers, blocks, power):
+    """:func:`histogram_features`' entries as a dense array, in one compiled pass."""
+    column_of = {layer: j for j, layer in enumerate(layers)}
+    spec, start = [], 0
+    for kind, layer, parts, width in blocks:
+        k = width // parts if kind == "occupancy" else int(np.sqrt(width))
+        spec.append((0 if kind == "occupancy" else 1, column_of[layer], parts, k, start))
+        start += width
+    rows = histogram_rows(
+        np.ascontiguousarray(nodes, dtype=np.intp),
+        np.ascontiguousarray(offsets, dtype=np.intp),
+        np.array(spec, dtype=np.intp).reshape(-1, 5),
+        start,
+        power == 0.5,  # the square root, NumPy's power(x, 0.5) to the bit
+    )
+    if power not in (0.5, 1):  # NumPy's pow on the entries, as the sparse matrix's
+        filled = rows != 0
+        rows[filled] = np.power(rows[filled], power)
+    return rows
 
 
 def residual_features(frames, nodes, offsets, means, center, scale, power):

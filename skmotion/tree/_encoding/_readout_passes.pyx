@@ -5,7 +5,9 @@ A clip's residuals (per node, the mean offset of its frames from the node's mean
 moments (per channel, the mean and root mean square in training units) were about forty
 small NumPy operations per call; on one clip of a few dozen frames their fixed costs were
 most of the encoder's ``transform``. Here each clip is read once per block, its sums
-taken in frame order into the output row, and the row finished in place.
+taken in frame order into the output row, and the row finished in place. The dense
+occupancy (and transitions) of ``histogram_rows`` are the entries of the sparse matrix
+that ``histogram_features`` builds, without building it (a third of a dense transform).
 
 The arithmetic is that of the NumPy expressions it replaces, operation for operation, so
 the results are the same doubles (``tests/tree/test_encoder_readouts.py``):
@@ -260,6 +262,91 @@ def moment_rows(const double[:, ::1] frames, const intp[::1] offsets, const doub
                         row[column + c] += w * (x * x)
                 for c in range(d):
                     row[column + c] = sqrt(row[column + c]) / scale[c] - 1.0
+    return rows_array
+
+
+def histogram_rows(const intp[:, ::1] nodes, const intp[::1] offsets,
+                   const intp[:, ::1] blocks, intp width, bint root):
+    """Per clip, the shares of its frames in each node and pyramid cell (and of its steps
+    between nodes), dense: the entries of ``histogram_features``' sparse matrix.
+
+    Each frame adds ``1 / (frames in its cell)`` (a step ``1 / (steps of its clip)``) to
+    its entry, in frame order from 0.0; the sparse matrix sums the same equal addends, so
+    the sums are the same doubles whatever order it adds them in. With ``root``, every
+    entry is then replaced by its square root (NumPy's ``power(x, 0.5)``).
+
+    Parameters
+    ----------
+    nodes : ndarray of shape (n_frames, n_routed) of intp
+        Each frame's node in each routed layer.
+    offsets : ndarray of shape (n_clips + 1,) of intp
+        Clip ``i`` is frames ``offsets[i]:offsets[i + 1]`` (checked).
+    blocks : ndarray of shape (n_blocks, 5) of intp
+        Per block: kind (0 occupancy, 1 transitions), its column of ``nodes``, its
+        pyramid parts (1 for transitions), the layer's nodes ``k`` and its first column.
+    width : int
+        Columns of the answer.
+    root : bool
+
+    Returns
+    -------
+    rows : ndarray of shape (n_clips, width)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from skmotion.tree._encoding._readout_passes import histogram_rows
+    >>> nodes = np.array([[0], [1], [1]])  # one clip of three frames, a layer of two nodes
+    >>> blocks = np.array([[0, 0, 1, 2, 0], [1, 0, 1, 2, 2]])  # occupancy, then transitions
+    >>> (histogram_rows(nodes, np.array([0, 3]), blocks, 6, False) * 6).round(12).tolist()
+    [[2.0, 4.0, 0.0, 3.0, 0.0, 0.0]]
+    """
+    cdef intp n = nodes.shape[0], n_clips = offsets.shape[0] - 1, n_blocks = blocks.shape[0]
+    cdef intp b, i, t, cell, kind, column, parts, k, first, start, length, most = 1, a, z
+    cdef double v
+    _check_offsets(offsets, n)
+    if blocks.shape[1] != 5:
+        raise ValueError("blocks must have five columns: kind, column, parts, nodes, start.")
+    for b in range(n_blocks):
+        kind, column, parts, k, first = (blocks[b, 0], blocks[b, 1], blocks[b, 2], blocks[b, 3],
+                                         blocks[b, 4])
+        if kind not in (0, 1) or not 0 <= column < nodes.shape[1] or parts < 1 or k < 1 or (
+                first < 0 or first + (parts * k if kind == 0 else k * k) > width):
+            raise ValueError(f"block {b} does not fit {nodes.shape[1]} routed layers and "
+                             f"{width} columns: {list(blocks[b])}.")
+        for t in range(n):
+            if not 0 <= nodes[t, column] < k:
+                raise ValueError(f"frame {t}'s node {nodes[t, column]} is outside 0 .. {k - 1}.")
+        most = max(most, parts)
+    rows_array = np.zeros((max(n_clips, 0), width))
+    size_array = np.empty(most, dtype=np.intp)
+    cdef double[:, ::1] rows = rows_array
+    cdef intp[::1] size = size_array
+    with nogil:
+        for b in range(n_blocks):
+            kind, column, parts, k, first = (blocks[b, 0], blocks[b, 1], blocks[b, 2],
+                                             blocks[b, 3], blocks[b, 4])
+            for i in range(n_clips):
+                start, length = offsets[i], offsets[i + 1] - offsets[i]
+                if kind == 0:
+                    # frame t of the clip is in cell t * parts // length
+                    for cell in range(parts):
+                        size[cell] = 0
+                    for t in range(length):
+                        size[t * parts // length] += 1
+                    for t in range(length):
+                        cell = t * parts // length
+                        rows[i, first + cell * k + nodes[start + t, column]] += 1.0 / size[cell]
+                elif length > 1:
+                    v = 1.0 / (length - 1)
+                    for t in range(start, start + length - 1):
+                        a, z = nodes[t, column], nodes[t + 1, column]
+                        if a != z:
+                            rows[i, first + a * k + z] += v
+        if root:
+            for i in range(n_clips):
+                for t in range(width):
+                    rows[i, t] = sqrt(rows[i, t])
     return rows_array
 
 
