@@ -95,6 +95,9 @@ forward_loops = module("skmotion.kinematics._forward_loops")
 # Each clip's channel covariance, its triangle row by row, one dsyrk per clip
 # (recognition/_motion_classifier.clip_covariances).
 covariance_rows = module("skmotion.recognition._covariance_rows")
+# SciPy's BLAS and LAPACK functions looked up through the pointers SciPy exports, for the
+# modules above that call them (_leading, _node_passes, _covariance_rows): no build-time SciPy.
+scipy_blas = module("skmotion.utils._scipy_blas")
 setup(
     ext_modules=cythonize(
         [
@@ -114,6 +117,7 @@ setup(
             live_path,
             forward_loops,
             covariance_rows,
+            scipy_blas,
         ]
     )
 )

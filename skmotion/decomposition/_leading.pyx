@@ -30,12 +30,11 @@ this loop does not have.
 
 import numpy as np
 
-from cpython.pycapsule cimport PyCapsule_GetName, PyCapsule_GetPointer
 from libc.math cimport INFINITY, fabs, sqrt
 from libc.stdlib cimport free, malloc
 
-ctypedef void (*dsyrk_t)(char*, char*, int*, int*, double*, double*, int*, double*,
-                         double*, int*) noexcept nogil
+from skmotion.utils._scipy_blas cimport dsyrk_t, scipy_function
+
 ctypedef void (*dsymv_t)(char*, int*, double*, double*, int*, double*, int*, double*,
                          double*, int*) noexcept nogil
 ctypedef void (*dgemv_t)(char*, int*, int*, double*, double*, int*, double*, int*, double*,
@@ -62,23 +61,16 @@ cdef dgemv_t _dgemv
 cdef dsyevr_t _dsyevr
 
 
-cdef void* _pointer(module, str name) except NULL:
-    capsule = module.__pyx_capi__[name]
-    return PyCapsule_GetPointer(capsule, PyCapsule_GetName(capsule))
-
-
 def _load():
     global _dsyrk, _dsymv, _dgemv, _dsyevr, _dgemm, _dsymm, _dgeqrf, _dorgqr
-    from scipy.linalg import cython_blas, cython_lapack
-
-    _dsyrk = <dsyrk_t>_pointer(cython_blas, "dsyrk")
-    _dsymv = <dsymv_t>_pointer(cython_blas, "dsymv")
-    _dgemv = <dgemv_t>_pointer(cython_blas, "dgemv")
-    _dsyevr = <dsyevr_t>_pointer(cython_lapack, "dsyevr")
-    _dgemm = <dgemm_t>_pointer(cython_blas, "dgemm")
-    _dsymm = <dsymm_t>_pointer(cython_blas, "dsymm")
-    _dgeqrf = <dgeqrf_t>_pointer(cython_lapack, "dgeqrf")
-    _dorgqr = <dorgqr_t>_pointer(cython_lapack, "dorgqr")
+    _dsyrk = <dsyrk_t>scipy_function("blas", "dsyrk")
+    _dsymv = <dsymv_t>scipy_function("blas", "dsymv")
+    _dgemv = <dgemv_t>scipy_function("blas", "dgemv")
+    _dsyevr = <dsyevr_t>scipy_function("lapack", "dsyevr")
+    _dgemm = <dgemm_t>scipy_function("blas", "dgemm")
+    _dsymm = <dsymm_t>scipy_function("blas", "dsymm")
+    _dgeqrf = <dgeqrf_t>scipy_function("lapack", "dgeqrf")
+    _dorgqr = <dorgqr_t>scipy_function("lapack", "dorgqr")
 
 
 _load()

@@ -11,27 +11,11 @@ its triangle per clip; the fancy index alone cost a third of the time on 192 cha
 
 import numpy as np
 
-from cpython.pycapsule cimport PyCapsule_GetName, PyCapsule_GetPointer
+from skmotion.utils._scipy_blas cimport dsyrk_t, scipy_function
 
 ctypedef Py_ssize_t intp
-ctypedef void (*dsyrk_t)(char*, char*, int*, int*, double*, double*, int*, double*,
-                         double*, int*) noexcept nogil
-cdef dsyrk_t _dsyrk
 
-
-cdef void* _pointer(module, str name) except NULL:
-    capsule = module.__pyx_capi__[name]
-    return PyCapsule_GetPointer(capsule, PyCapsule_GetName(capsule))
-
-
-def _load():
-    global _dsyrk
-    from scipy.linalg import cython_blas
-
-    _dsyrk = <dsyrk_t>_pointer(cython_blas, "dsyrk")
-
-
-_load()
+cdef dsyrk_t _dsyrk = <dsyrk_t>scipy_function("blas", "dsyrk")
 
 
 def covariance_rows(const double[:, ::1] frames, const intp[::1] offsets, out=None):

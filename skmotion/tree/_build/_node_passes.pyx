@@ -21,32 +21,17 @@ Without the GIL, the nodes of a layer can be processed in threads.
 
 import numpy as np
 
-from cpython.pycapsule cimport PyCapsule_GetName, PyCapsule_GetPointer
 from libc.string cimport memcpy
 
+from skmotion.utils._scipy_blas cimport dsyrk_t, scipy_function
+
 ctypedef Py_ssize_t intp
-ctypedef void (*dsyrk_t)(char*, char*, int*, int*, double*, double*, int*, double*,
-                         double*, int*) noexcept nogil
-cdef dsyrk_t _dsyrk
+
+cdef dsyrk_t _dsyrk = <dsyrk_t>scipy_function("blas", "dsyrk")
 
 # Rows per chunk: a buffer of about 256 KB, which stays in the cache between the
 # centring and the product.
 cdef intp _CHUNK_VALUES = 32768
-
-
-cdef void* _pointer(module, str name) except NULL:
-    capsule = module.__pyx_capi__[name]
-    return PyCapsule_GetPointer(capsule, PyCapsule_GetName(capsule))
-
-
-def _load():
-    global _dsyrk
-    from scipy.linalg import cython_blas
-
-    _dsyrk = <dsyrk_t>_pointer(cython_blas, "dsyrk")
-
-
-_load()
 
 
 def moment_chunk_rows(intp d):
