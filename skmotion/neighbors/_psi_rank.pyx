@@ -13,21 +13,7 @@ import numpy as np
 
 from libc.math cimport fabs
 
-
-cdef inline double _dot(const double* a, const double* b, Py_ssize_t n) noexcept nogil:
-    # Four partial sums: independent chains the processor can overlap.
-    cdef double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0
-    cdef Py_ssize_t i = 0
-    while i + 4 <= n:
-        s0 += a[i] * b[i]
-        s1 += a[i + 1] * b[i + 1]
-        s2 += a[i + 2] * b[i + 2]
-        s3 += a[i + 3] * b[i + 3]
-        i += 4
-    while i < n:
-        s0 += a[i] * b[i]
-        i += 1
-    return (s0 + s1) + (s2 + s3)
+from skmotion.utils._dot cimport dot4
 
 
 def psi_distances(
@@ -68,7 +54,7 @@ def psi_distances(
                 total = 0.0
                 for i in range(k):
                     total += (query_weights[q, i] + stored_weights[s, i]) * fabs(
-                        _dot(&query_vectors[q, i, 0], &stored_vectors[s, i, 0], n)
+                        dot4(&query_vectors[q, i, 0], &stored_vectors[s, i, 0], n)
                     )
                 total *= 0.5
                 # Rounding can push a perfect match a hair above 1.

@@ -11,23 +11,9 @@ training projections far wider than that (``best_split``'s gap rule), so a train
 goes where the build put it.
 """
 
+from skmotion.utils._dot cimport dot4
+
 ctypedef Py_ssize_t intp
-
-
-cdef inline double _dot(const double* a, const double* b, intp d) noexcept nogil:
-    """``a . b`` over four accumulators (independent additions: no wait on each sum)."""
-    cdef double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0
-    cdef intp c = 0
-    while c + 4 <= d:
-        s0 += a[c] * b[c]
-        s1 += a[c + 1] * b[c + 1]
-        s2 += a[c + 2] * b[c + 2]
-        s3 += a[c + 3] * b[c + 3]
-        c += 4
-    while c < d:
-        s0 += a[c] * b[c]
-        c += 1
-    return (s0 + s1) + (s2 + s3)
 
 
 def walk_frames(const double[:, ::1] frames, const double[:, ::1] axis,
@@ -97,7 +83,7 @@ def walk_frames(const double[:, ::1] frames, const double[:, ::1] axis,
                     if kk == n_wanted:
                         break
                 if left[nd] >= 0:
-                    if _dot(&frames[i, 0], &axis[nd, 0], d) > threshold[nd]:
+                    if dot4(&frames[i, 0], &axis[nd, 0], d) > threshold[nd]:
                         nd = right[nd]
                     else:
                         nd = left[nd]
