@@ -68,7 +68,7 @@ def block_scales(frames, blocks, weights):
     return scale
 
 
-def clip_covariances(clips):
+def clip_covariances(clips, out=None):
     """The covariance of each clip's channels over its frames: the upper triangle, row by row.
 
     Which channels move together, and how much, whatever the order of the
@@ -78,6 +78,9 @@ def clip_covariances(clips):
     Parameters
     ----------
     clips : list of ndarray of shape (n_frames_i, n_channels)
+
+    out : ndarray of shape (n_clips, n_channels * (n_channels + 1) // 2), default=None
+        Written in place and returned (e.g. the last columns of a larger table).
 
     Returns
     -------
@@ -94,7 +97,7 @@ def clip_covariances(clips):
     """
     # one compiled pass: per clip its centred frames, one dsyrk, the triangle copied out
     frames, offsets = stack_clips(clips)
-    return covariance_rows(np.ascontiguousarray(frames, dtype=np.float64), offsets)
+    return covariance_rows(np.ascontiguousarray(frames, dtype=np.float64), offsets, out)
 
 
 def fit_in_span(model, columns, y):
@@ -470,8 +473,7 @@ class MotionClassifier(ClipEstimatorMixin, ClassifierMixin, BaseEstimator):
         n_channels, width = clips[0].shape[1], encoded.shape[1]
         table = np.empty((len(clips), width + n_channels * (n_channels + 1) // 2))
         table[:, :width] = encoded
-        frames, offsets = stack_clips(clips)
-        covariance_rows(frames, offsets, table[:, width:])
+        clip_covariances(clips, out=table[:, width:])
         return table
 
     def _columns(self, features):

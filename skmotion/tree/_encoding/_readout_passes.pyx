@@ -88,6 +88,17 @@ cdef void _signed_root_unit_norm(double* row, intp n, bint root) noexcept nogil:
             row[i] = row[i] / norm
 
 
+cdef inline void _cell_sizes(intp* size, intp parts, intp length) noexcept nogil:
+    """``size[cell]``: the frames of a clip of ``length`` in each of its ``parts`` pyramid
+    cells, frame ``t`` being in cell ``t * parts // length`` (the occupancy's and the
+    moments' pyramids alike)."""
+    cdef intp cell, t
+    for cell in range(parts):
+        size[cell] = 0
+    for t in range(length):
+        size[t * parts // length] += 1
+
+
 cdef int _check_offsets(const intp[::1] offsets, intp n_frames) except -1:
     cdef intp i
     if offsets.shape[0] < 1 or offsets[0] != 0 or offsets[offsets.shape[0] - 1] != n_frames:
@@ -236,11 +247,7 @@ def moment_rows(const double[:, ::1] frames, const intp[::1] offsets, const doub
             column = 0
             for j in range(n_levels):
                 p = pyramid[j]
-                # frame t of the clip is in cell t * p // length (as the occupancy pyramid)
-                for cell in range(p):
-                    size[cell] = 0
-                for t in range(length):
-                    size[t * p // length] += 1
+                _cell_sizes(&size[0], p, length)
                 for t in range(length):
                     cell = t * p // length
                     w = 1.0 / size[cell]
@@ -329,11 +336,7 @@ def histogram_rows(const intp[:, ::1] nodes, const intp[::1] offsets,
             for i in range(n_clips):
                 start, length = offsets[i], offsets[i + 1] - offsets[i]
                 if kind == 0:
-                    # frame t of the clip is in cell t * parts // length
-                    for cell in range(parts):
-                        size[cell] = 0
-                    for t in range(length):
-                        size[t * parts // length] += 1
+                    _cell_sizes(&size[0], parts, length)
                     for t in range(length):
                         cell = t * parts // length
                         rows[i, first + cell * k + nodes[start + t, column]] += 1.0 / size[cell]

@@ -91,9 +91,7 @@ class TreeRouter:
             np.arange(self.n_layers) if layers is None else np.ascontiguousarray(layers, np.intp)
         )
         out = np.empty((len(frames), len(layers)), dtype=np.intp)
-        walk_frames(
-            frames, self.axis, self.threshold, self.left, self.right, self.layer_index, layers, out
-        )
+        self._walk(frames, layers, out)
         return out
 
     def route_clips(self, clips, layers=None):
@@ -119,16 +117,12 @@ class TreeRouter:
         start = 0
         for clip in clips:
             frames = np.ascontiguousarray(clip, dtype=np.float64)
-            rows = out[start : start + len(frames)]
-            walk_frames(
-                frames,
-                self.axis,
-                self.threshold,
-                self.left,
-                self.right,
-                self.layer_index,
-                layers,
-                rows,
-            )
+            self._walk(frames, layers, out[start : start + len(frames)])
             start += len(frames)
         return out
+
+    def _walk(self, frames, layers, out):
+        """The compiled walk of C-contiguous float64 ``frames`` into ``out``, in place."""
+        walk_frames(
+            frames, self.axis, self.threshold, self.left, self.right, self.layer_index, layers, out
+        )
